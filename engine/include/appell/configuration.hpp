@@ -1,0 +1,40 @@
+// The configuration manifold: q lives on ℝⁿ × SO(3)ᵏ, v in its tangent space.
+//
+// Integrators step in local coordinates θ ∈ ℝ^nv around a base point q₀
+// (Runge–Kutta–Munthe-Kaas): q = retract(q₀, θ), with θ̇ = localRate(q₀, θ, v).
+//   Euclidean coordinates (revolute, prismatic, planar (a, b, φ), the floating
+//   base's position) retract by addition; quaternions by q₀ ⊗ exp(θ).
+// So a quaternion is never advanced by adding to it: a step is an exact
+// rotation, and renormalising is not what keeps it unit.
+#pragma once
+
+#include <appell/model.hpp>
+
+#include <random>
+
+namespace appell {
+
+/// The zero configuration (identity quaternions).
+VecX neutralConfiguration(const Model& model);
+
+/// q = retract(q0, θ): move from q0 by the local coordinates θ (size nv).
+void retract(const Model& model, const VecX& q0, const VecX& theta, VecX& q);
+
+/// θ̇ = T(q0, θ) v: rate of the local coordinates for velocity v at q = retract(q0, θ).
+void localRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
+               VecX& theta_dot);
+
+/// θ with retract(q0, θ) = q1 (the shortest rotation for quaternions).
+void difference(const Model& model, const VecX& q0, const VecX& q1, VecX& theta);
+
+/// q̇ = G(q) v, as an nq-vector (for reports and finite differences).
+void configurationRate(const Model& model, const VecX& q, const VecX& v, VecX& qdot);
+
+/// Renormalise every quaternion (after loading user input; not part of stepping).
+void normalizeQuaternions(const Model& model, VecX& q);
+
+/// A random configuration: angles in [−π, π], displacements in [−1, 1],
+/// uniformly random unit quaternions.
+VecX randomConfiguration(const Model& model, std::mt19937& rng);
+
+}  // namespace appell

@@ -1,0 +1,70 @@
+// Pfaffian constraints  A(q, t) v + b(q, t) = 0  and how solvers see them.
+//
+// A contact (or any constraint) produces up to 6 rows acting on one body, or
+// on the relative motion of two bodies. Each row is a world-frame spatial
+// covector w on the body's world-frame spatial velocity V = [ω; v_O] (v_O: the
+// velocity of the body point now at the world origin, Featherstone's convention):
+//      row value      wₐ·Vₐ − w_b·V_b + b = 0
+//      acceleration   wₐ·aₐ − w_b·a_b + κ = 0,   a = dV/dt (spatial acceleration)
+// κ carries every velocity-product term of the geometry (ẇ·V, ḃ): the contact
+// layer knows the curvatures, the engine knows the tree. A point-velocity row
+// tᵀ ṗ for a point x on the body is w = [x × t; t].
+//
+// Rows that are not naturally body-local (user-supplied rows over v) say
+// jointSpace() and give A, b and Ȧv + ḃ over the generalized velocities.
+#pragma once
+
+#include <appell/data.hpp>
+
+#include <string>
+
+namespace appell {
+
+using RowMatrix6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
+using RowVector6 = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+
+/// Geometric description of a contact at the current state, for reports.
+struct ContactFrame {
+  Vec3 point = Vec3::Zero();        ///< contact point, world
+  Vec3 normal = Vec3::UnitZ();      ///< unit normal, world, from the support toward the body
+  Vec3 t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
+  double gap = 0;                   ///< signed distance (negative: penetration)
+};
+
+/// What one constraint writes when evaluated. Capacity is fixed (≤ 6 body rows),
+/// except the joint-space block, which is sized once by the constraint's setup.
+struct RowBlock {
+  int m = 0;                        ///< rows written
+  RowMatrix6 Wa, Wb;                ///< m × 6, world-frame spatial covectors
+  RowVector6 b, kappa;              ///< velocity and acceleration offsets
+  RowVector6 gap;                   ///< holonomic gap per row (0 where not holonomic)
+  MatX A_joint;                     ///< jointSpace(): m × nv
+  VecX b_joint, abias_joint;        ///< jointSpace(): b and Ȧv + ḃ (size m)
+  ContactFrame frame;
+  bool singular = false;            ///< the geometry is singular here (rows unusable)
+  std::string singular_reason;      ///< why, when singular (set only then)
+};
+
+class Constraint {
+ public:
+  virtual ~Constraint() = default;
+  virtual const std::string& name() const = 0;
+  /// Number of rows (fixed for the constraint's lifetime).
+  virtual int rows() const = 0;
+  /// Body the rows act on, and the second body (−1: the world / none).
+  virtual int bodyA() const = 0;
+  virtual int bodyB() const { return -1; }
+  /// Label of row k, e.g. "normal", "tangent1", "tangent2", "spin", "lateral".
+  virtual std::string rowLabel(int k) const = 0;
+  /// Row k is ġ for a gap g(q, t) — the position projection drives g to 0.
+  virtual bool holonomic(int k) const = 0;
+  /// Rows given over v (A_joint …) rather than as body covectors.
+  virtual bool jointSpace() const { return false; }
+  /// Constant-size storage the block needs (called once, outside the step).
+  virtual void reserve(const Model& model, RowBlock& block) const;
+  /// Writes the rows at (q, v, t). `data` holds forwardKinematics(q, v).
+  virtual void evaluate(const Model& model, const Data& data, double t, const VecX& q,
+                        const VecX& v, RowBlock& out) const = 0;
+};
+
+}  // namespace appell

@@ -1,0 +1,68 @@
+// Time integrators for  q̇ = G(q) v,  v̇ = f(t, q, v)  on the configuration manifold.
+//
+// All three step in local coordinates (configuration.hpp), so quaternions move
+// by exact rotations:
+//   SymplecticEuler  v⁺ = v + h f(q, v),  q⁺ = retract(q, h v⁺)     order 1
+//   RK4              classic 4-stage Runge–Kutta–Munthe-Kaas       order 4
+//   DormandPrince54  embedded 5(4) pair, FSAL, error control on (θ, v)
+//                    with rtol/atol and the usual PI-free step controller
+//                    (Hairer, Nørsett, Wanner I, §II.4–5)              order 5
+// Work vectors are allocated at construction; step() does not allocate.
+#pragma once
+
+#include <appell/model.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace appell {
+
+/// The acceleration field v̇ = f(t, q, v). Returning false means "this state is
+/// not admissible" (non-finite, singular); the integrator then rejects the step.
+class AccelerationField {
+ public:
+  virtual ~AccelerationField() = default;
+  virtual bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) = 0;
+};
+
+enum class IntegratorType { SymplecticEuler, RK4, DormandPrince54 };
+const char* toString(IntegratorType type);
+/// Parses "euler"/"symplectic-euler", "rk4", "dopri5"/"dormand-prince"; throws
+/// std::invalid_argument naming the accepted values otherwise.
+IntegratorType integratorFromString(const std::string& name);
+
+struct IntegratorOptions {
+  double rtol = 1e-8;        ///< adaptive only
+  double atol = 1e-10;       ///< adaptive only
+  double h_min = 1e-14;      ///< adaptive: give up below this step
+  double h_max = 0.1;        ///< adaptive: never step further
+  double safety = 0.9;
+};
+
+struct StepResult {
+  bool ok = true;            ///< false: the state became non-finite or the step fell below h_min
+  double h_taken = 0;        ///< step actually taken (0 if !ok)
+  double h_next = 0;         ///< suggested next step (adaptive) or the same h
+  double error = 0;          ///< scaled error norm of the accepted step (adaptive; 0 otherwise)
+  int rejected = 0;          ///< rejected attempts before acceptance
+  int evaluations = 0;       ///< calls to the field
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual IntegratorType type() const = 0;
+  virtual bool adaptive() const { return false; }
+  /// One step from (t, q, v) with step h (the first attempt, for adaptive
+  /// methods). On success t, q, v are advanced; on failure they are untouched.
+  virtual StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) = 0;
+  /// Forget any state carried between steps (the FSAL stage); call after the
+  /// caller changes q or v itself (projection, an impulse).
+  virtual void reset() {}
+};
+
+std::unique_ptr<Integrator> makeIntegrator(IntegratorType type, const Model& model,
+                                           const IntegratorOptions& options = {});
+
+}  // namespace appell

@@ -1,0 +1,116 @@
+// The kinematic tree: bodies, joints, inertias. Immutable once built.
+//
+// Bodies are numbered 0 … nbodies−1 in topological order (parent < child);
+// the world is −1. Body i's frame is the frame of the joint that connects it
+// to its parent, after the joint's motion (the URDF convention):
+//     pose of body i in its parent = placement[i] * jointTransform(q_i).
+//
+// Joint coordinates (nq) and velocities (nv), per joint type:
+//   fixed       nq 0  nv 0
+//   revolute,   nq 1  nv 1   angle / rate about `axis`
+//   continuous  (revolute without position limits)
+//   prismatic   nq 1  nv 1   displacement / rate along `axis`
+//   planar      nq 3  nv 3   q = (a, b, φ): displacement along t₁, t₂ and the
+//               angle about the normal `axis`;  v = (v₁, v₂, ω) in the BODY
+//               frame, so q̇ ≠ v:  (ȧ, ḃ) = Rot(φ) (v₁, v₂),  φ̇ = ω.
+//   floating    nq 7  nv 6   q = (p, quaternion x y z w);  v = (ω, v) in the BODY
+//               frame (Featherstone order):  ṗ = R v,  quaternion: q̇ = ½ q ⊗ ω.
+//   ball        nq 4  nv 3   q = quaternion x y z w;  v = ω in the BODY frame.
+// Every motion subspace S is constant in the body frame, so Ṡ q̇ = 0 for all.
+#pragma once
+
+#include <appell/spatial.hpp>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace appell {
+
+enum class JointType { Fixed, Revolute, Continuous, Prismatic, Planar, Floating, Ball };
+
+const char* toString(JointType type);
+int jointNq(JointType type);
+int jointNv(JointType type);
+
+/// Position limits kept from the model description (not enforced by the
+/// dynamics; reported and available to controllers and contact code).
+struct JointLimits {
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  double velocity = std::numeric_limits<double>::infinity();
+  double effort = std::numeric_limits<double>::infinity();
+};
+
+struct Joint {
+  JointType type = JointType::Fixed;
+  /// Unit axis in the joint frame: rotation axis (revolute), translation
+  /// direction (prismatic), plane normal (planar). Unused otherwise.
+  Vec3 axis = Vec3::UnitZ();
+  int idx_q = 0, idx_v = 0, nq = 0, nv = 0;
+  /// Motion subspace in the body frame (6 × nv), constant.
+  Mat6X S;
+  /// Planar joints: in-plane directions t₁, t₂ (with axis, right-handed).
+  Vec3 t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
+  JointLimits limits;
+};
+
+struct Model {
+  int nbodies = 0;
+  int nq = 0;
+  int nv = 0;
+  std::vector<int> parent;          ///< parent body, −1 = world
+  std::vector<SE3> placement;       ///< joint frame in the parent body's frame
+  std::vector<Joint> joints;        ///< joint i connects body i to parent[i]
+  std::vector<Inertia> inertias;    ///< body inertia in the body frame
+  std::vector<Mat6> spatial_inertia;///< inertias[i].matrix(), cached
+  std::vector<std::string> body_names;
+  std::vector<std::string> joint_names;
+  std::vector<std::vector<int>> children;
+  /// Body that velocity index k belongs to, and the depth-first "support":
+  /// for each body, the bodies on its path to the root (itself first).
+  std::vector<int> body_of_v;
+  std::vector<std::vector<int>> support;
+  Vec3 gravity{0, 0, -9.81};
+
+  int bodyIndex(const std::string& name) const;   ///< −1 if absent
+  int jointIndex(const std::string& name) const;  ///< −1 if absent
+  /// True when body `ancestor` lies on the path from `body` to the root (or is it).
+  bool isAncestor(int ancestor, int body) const;
+  double totalMass() const;
+};
+
+/// Error in a model description: which element, and why.
+struct ModelError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Builds a Model body by body. `build()` validates everything (positive mass
+/// unless the body is a massless fixed attachment, positive-definite inertia
+/// satisfying the triangle inequality, finite numbers, unit axes) and throws
+/// ModelError naming the body and the reason.
+class ModelBuilder {
+ public:
+  /// Adds a body attached to `parent` (−1 = world) by `joint`, whose frame sits
+  /// at `placement` in the parent's frame. Returns the new body's index.
+  int addBody(const std::string& name, int parent, const SE3& placement, JointType type,
+              const Vec3& axis, const Inertia& inertia, const std::string& joint_name = "",
+              const JointLimits& limits = {});
+  void setGravity(const Vec3& g) { gravity_ = g; }
+  Model build() const;
+
+ private:
+  struct Entry {
+    std::string name, joint_name;
+    int parent;
+    SE3 placement;
+    JointType type;
+    Vec3 axis;
+    Inertia inertia;
+    JointLimits limits;
+  };
+  std::vector<Entry> entries_;
+  Vec3 gravity_{0, 0, -9.81};
+};
+
+}  // namespace appell
