@@ -8,3 +8,5 @@
 #include <appell/kinematics.hpp>
 #include <appell/dynamics.hpp>
 #include <appell/integrators.hpp>
+#include <appell/constraint.hpp>
+#include <appell/constraint_set.hpp>

@@ -13,6 +13,13 @@ void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX
 void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX& v,
                        const VecX& a);
 
+/// World-frame spatial velocity V = [ω; v_O] and acceleration dV/dt of a body
+/// (v_O: velocity of the body point now at the world origin).
+Vec6 spatialVelocityWorld(const Data& data, int body);
+Vec6 spatialAccelerationWorld(const Data& data, int body);
+/// World-frame spatial Jacobian (6 × nv): V = J v. Needs forwardKinematics(q).
+void spatialJacobianWorld(const Model& model, const Data& data, int body, MatX& J);
+
 /// Kinematic quantities of a point fixed in a body, in the world frame.
 /// Require forwardKinematics with at least the matching inputs first.
 Vec3 pointPosition(const Data& data, int body, const Vec3& point_local);

@@ -21,6 +21,7 @@
 
 #include <appell/spatial.hpp>
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>

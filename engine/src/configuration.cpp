@@ -1,0 +1,158 @@
+#include <appell/configuration.hpp>
+
+#include <cmath>
+#include <numbers>
+
+namespace appell {
+
+namespace {
+
+Quat quatAt(const VecX& q, int i) { return Quat(q[i + 3], q[i], q[i + 1], q[i + 2]); }
+void setQuat(VecX& q, int i, const Quat& r) {
+  q[i] = r.x(); q[i + 1] = r.y(); q[i + 2] = r.z(); q[i + 3] = r.w();
+}
+
+}  // namespace
+
+VecX neutralConfiguration(const Model& model) {
+  VecX q = VecX::Zero(model.nq);
+  for (const Joint& j : model.joints) {
+    if (j.type == JointType::Floating) q[j.idx_q + 6] = 1;
+    if (j.type == JointType::Ball) q[j.idx_q + 3] = 1;
+  }
+  return q;
+}
+
+// Local coordinates per joint (θ has the layout of v):
+//   Euclidean coordinates      θ = q − q₀              (planar: Δa, Δb, Δφ)
+//   floating  θ = (θ_R, Δp)    R = R₀ exp(θ_R), p = p₀ + Δp (world)
+//   ball      θ = θ_R
+void retract(const Model& model, const VecX& q0, const VecX& theta, VecX& q) {
+  q = q0;
+  for (const Joint& j : model.joints) {
+    switch (j.type) {
+      case JointType::Fixed: break;
+      case JointType::Floating:
+        q.segment<3>(j.idx_q) += theta.segment<3>(j.idx_v + 3);
+        setQuat(q, j.idx_q + 3, quatAt(q0, j.idx_q + 3) * quatExp(theta.segment<3>(j.idx_v)));
+        break;
+      case JointType::Ball:
+        setQuat(q, j.idx_q, quatAt(q0, j.idx_q) * quatExp(theta.segment<3>(j.idx_v)));
+        break;
+      default:
+        q.segment(j.idx_q, j.nq) += theta.segment(j.idx_v, j.nv);
+    }
+  }
+}
+
+void localRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
+               VecX& theta_dot) {
+  for (const Joint& j : model.joints) {
+    const int iv = j.idx_v;
+    switch (j.type) {
+      case JointType::Fixed: break;
+      case JointType::Floating: {
+        const Vec3 th = theta.segment<3>(iv);
+        const Quat r = quatAt(q0, j.idx_q + 3) * quatExp(th);
+        theta_dot.segment<3>(iv) = dexpInv(th) * v.segment<3>(iv);
+        theta_dot.segment<3>(iv + 3) = r * Vec3(v.segment<3>(iv + 3));
+        break;
+      }
+      case JointType::Ball:
+        theta_dot.segment<3>(iv) = dexpInv(theta.segment<3>(iv)) * v.segment<3>(iv);
+        break;
+      case JointType::Planar: {
+        const double phi = q0[j.idx_q + 2] + theta[iv + 2];
+        const double c = std::cos(phi), s = std::sin(phi);
+        theta_dot[iv] = c * v[iv] - s * v[iv + 1];
+        theta_dot[iv + 1] = s * v[iv] + c * v[iv + 1];
+        theta_dot[iv + 2] = v[iv + 2];
+        break;
+      }
+      default:
+        theta_dot[iv] = v[iv];
+    }
+  }
+}
+
+void difference(const Model& model, const VecX& q0, const VecX& q1, VecX& theta) {
+  for (const Joint& j : model.joints) {
+    const int iv = j.idx_v;
+    switch (j.type) {
+      case JointType::Fixed: break;
+      case JointType::Floating:
+        theta.segment<3>(iv) = quatLog(quatAt(q0, j.idx_q + 3).conjugate() * quatAt(q1, j.idx_q + 3));
+        theta.segment<3>(iv + 3) = q1.segment<3>(j.idx_q) - q0.segment<3>(j.idx_q);
+        break;
+      case JointType::Ball:
+        theta.segment<3>(iv) = quatLog(quatAt(q0, j.idx_q).conjugate() * quatAt(q1, j.idx_q));
+        break;
+      default:
+        theta.segment(iv, j.nv) = q1.segment(j.idx_q, j.nq) - q0.segment(j.idx_q, j.nq);
+    }
+  }
+}
+
+void configurationRate(const Model& model, const VecX& q, const VecX& v, VecX& qdot) {
+  qdot.resize(model.nq);
+  for (const Joint& j : model.joints) {
+    const int iq = j.idx_q, iv = j.idx_v;
+    auto quatRate = [&](int at, const Vec3& w) {
+      // q̇ = ½ q ⊗ (0, ω) for the body angular velocity ω.
+      const Quat r = quatAt(q, at);
+      const Quat d = r * Quat(0, w.x(), w.y(), w.z());
+      setQuat(qdot, at, Quat(0.5 * d.w(), 0.5 * d.x(), 0.5 * d.y(), 0.5 * d.z()));
+    };
+    switch (j.type) {
+      case JointType::Fixed: break;
+      case JointType::Floating:
+        qdot.segment<3>(iq) = quatAt(q, iq + 3) * Vec3(v.segment<3>(iv + 3));
+        quatRate(iq + 3, v.segment<3>(iv));
+        break;
+      case JointType::Ball: quatRate(iq, v.segment<3>(iv)); break;
+      case JointType::Planar: {
+        const double c = std::cos(q[iq + 2]), s = std::sin(q[iq + 2]);
+        qdot[iq] = c * v[iv] - s * v[iv + 1];
+        qdot[iq + 1] = s * v[iv] + c * v[iv + 1];
+        qdot[iq + 2] = v[iv + 2];
+        break;
+      }
+      default: qdot[iq] = v[iv];
+    }
+  }
+}
+
+void normalizeQuaternions(const Model& model, VecX& q) {
+  for (const Joint& j : model.joints) {
+    int at = j.type == JointType::Floating ? j.idx_q + 3 : j.type == JointType::Ball ? j.idx_q : -1;
+    if (at >= 0) q.segment<4>(at).normalize();
+  }
+}
+
+VecX randomConfiguration(const Model& model, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::normal_distribution<double> gauss;
+  VecX q = neutralConfiguration(model);
+  auto randomQuat = [&](int at) {
+    Eigen::Vector4d g(gauss(rng), gauss(rng), gauss(rng), gauss(rng));  // uniform on S³
+    q.segment<4>(at) = g.normalized();
+  };
+  for (const Joint& j : model.joints) {
+    switch (j.type) {
+      case JointType::Fixed: break;
+      case JointType::Revolute: case JointType::Continuous: q[j.idx_q] = std::numbers::pi * unit(rng); break;
+      case JointType::Prismatic: q[j.idx_q] = unit(rng); break;
+      case JointType::Planar:
+        q[j.idx_q] = unit(rng); q[j.idx_q + 1] = unit(rng); q[j.idx_q + 2] = std::numbers::pi * unit(rng);
+        break;
+      case JointType::Floating:
+        for (int k = 0; k < 3; ++k) q[j.idx_q + k] = unit(rng);
+        randomQuat(j.idx_q + 3);
+        break;
+      case JointType::Ball: randomQuat(j.idx_q); break;
+    }
+  }
+  return q;
+}
+
+}  // namespace appell

@@ -1,0 +1,50 @@
+// The three integrators. Each keeps its stage vectors, sized at construction.
+#pragma once
+
+#include <appell/configuration.hpp>
+#include <appell/integrators.hpp>
+
+#include <array>
+
+namespace appell::detail {
+
+class SymplecticEuler final : public Integrator {
+ public:
+  explicit SymplecticEuler(const Model& model);
+  IntegratorType type() const override { return IntegratorType::SymplecticEuler; }
+  StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) override;
+
+ private:
+  const Model& model_;
+  VecX a_, v1_, theta_, q1_;
+};
+
+class RungeKutta4 final : public Integrator {
+ public:
+  explicit RungeKutta4(const Model& model);
+  IntegratorType type() const override { return IntegratorType::RK4; }
+  StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) override;
+
+ private:
+  const Model& model_;
+  std::array<VecX, 4> kth_, kv_;
+  VecX theta_, vs_, qs_;
+};
+
+class DormandPrince54 final : public Integrator {
+ public:
+  DormandPrince54(const Model& model, const IntegratorOptions& options);
+  IntegratorType type() const override { return IntegratorType::DormandPrince54; }
+  bool adaptive() const override { return true; }
+  StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) override;
+  void reset() override { have_fsal_ = false; }
+
+ private:
+  const Model& model_;
+  IntegratorOptions opt_;
+  std::array<VecX, 7> kth_, kv_;
+  VecX theta_, vs_, qs_, err_th_, err_v_, scale_q_;
+  bool have_fsal_ = false;
+};
+
+}  // namespace appell::detail

@@ -1,0 +1,191 @@
+#include <appell/model.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <sstream>
+
+namespace appell {
+
+const char* toString(JointType type) {
+  switch (type) {
+    case JointType::Fixed: return "fixed";
+    case JointType::Revolute: return "revolute";
+    case JointType::Continuous: return "continuous";
+    case JointType::Prismatic: return "prismatic";
+    case JointType::Planar: return "planar";
+    case JointType::Floating: return "floating";
+    case JointType::Ball: return "ball";
+  }
+  return "?";
+}
+
+int jointNq(JointType type) {
+  switch (type) {
+    case JointType::Fixed: return 0;
+    case JointType::Revolute: case JointType::Continuous: case JointType::Prismatic: return 1;
+    case JointType::Planar: return 3;
+    case JointType::Floating: return 7;
+    case JointType::Ball: return 4;
+  }
+  return 0;
+}
+
+int jointNv(JointType type) {
+  switch (type) {
+    case JointType::Floating: return 6;
+    case JointType::Ball: case JointType::Planar: return 3;
+    default: return jointNq(type);
+  }
+}
+
+int Model::bodyIndex(const std::string& name) const {
+  for (int i = 0; i < nbodies; ++i)
+    if (body_names[i] == name) return i;
+  return -1;
+}
+
+int Model::jointIndex(const std::string& name) const {
+  for (int i = 0; i < nbodies; ++i)
+    if (joint_names[i] == name) return i;
+  return -1;
+}
+
+bool Model::isAncestor(int ancestor, int body) const {
+  for (int i = body; i >= 0; i = parent[i])
+    if (i == ancestor) return true;
+  return false;
+}
+
+double Model::totalMass() const {
+  double m = 0;
+  for (const auto& I : inertias) m += I.mass;
+  return m;
+}
+
+int ModelBuilder::addBody(const std::string& name, int parent, const SE3& placement,
+                          JointType type, const Vec3& axis, const Inertia& inertia,
+                          const std::string& joint_name, const JointLimits& limits) {
+  entries_.push_back({name, joint_name.empty() ? name + "_joint" : joint_name, parent, placement,
+                      type, axis, inertia, limits});
+  return static_cast<int>(entries_.size()) - 1;
+}
+
+namespace {
+
+[[noreturn]] void fail(const std::string& body, const std::string& why) {
+  throw ModelError("body '" + body + "': " + why);
+}
+
+bool finite(const Eigen::MatrixBase<auto>& m) { return m.allFinite(); }
+
+// Rotational inertia about the centre of mass must be symmetric positive
+// definite and its principal moments must satisfy the triangle inequality
+// (I₁ + I₂ ≥ I₃): otherwise no mass distribution has it.
+void checkInertia(const std::string& body, const Inertia& I, bool may_be_massless) {
+  if (!std::isfinite(I.mass) || !finite(I.com) || !finite(I.inertia_com))
+    fail(body, "inertia has a non-finite value");
+  if (I.mass < 0) fail(body, "negative mass " + std::to_string(I.mass));
+  if (I.mass == 0) {
+    if (!may_be_massless) fail(body, "zero mass on a moving body with no massive descendants");
+    if (I.inertia_com.norm() != 0) fail(body, "zero mass but non-zero rotational inertia");
+    return;
+  }
+  const Mat3& J = I.inertia_com;
+  if ((J - J.transpose()).norm() > 1e-9 * (1 + J.norm())) fail(body, "inertia tensor is not symmetric");
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(J);
+  const Vec3 d = eig.eigenvalues();
+  const double tol = 1e-12 * std::max(1.0, d.cwiseAbs().maxCoeff());
+  if (d.minCoeff() <= 0) {
+    std::ostringstream s;
+    s << "inertia tensor is not positive definite (principal moments " << d.transpose() << ")";
+    fail(body, s.str());
+  }
+  if (d(0) + d(1) < d(2) - tol) {
+    std::ostringstream s;
+    s << "principal moments " << d.transpose() << " violate the triangle inequality";
+    fail(body, s.str());
+  }
+}
+
+}  // namespace
+
+Model ModelBuilder::build() const {
+  Model m;
+  const int n = static_cast<int>(entries_.size());
+  m.nbodies = n;
+  m.gravity = gravity_;
+  if (!gravity_.allFinite()) throw ModelError("gravity is not finite");
+  m.children.resize(n);
+  // Subtree mass decides whether a massless body is acceptable: a moving joint
+  // needs something with inertia beyond it.
+  std::vector<double> subtree_mass(n, 0.0);
+  for (int i = n - 1; i >= 0; --i) {
+    subtree_mass[i] += entries_[i].inertia.mass;
+    if (entries_[i].parent >= 0 && entries_[i].parent < i) subtree_mass[entries_[i].parent] += subtree_mass[i];
+  }
+  for (int i = 0; i < n; ++i) {
+    const Entry& e = entries_[i];
+    if (e.parent >= i || e.parent < -1)
+      fail(e.name, "parent index " + std::to_string(e.parent) + " is not an earlier body");
+    for (int k = 0; k < i; ++k)
+      if (entries_[k].name == e.name) fail(e.name, "two bodies share this name");
+    if (!finite(e.placement.R) || !finite(e.placement.p)) fail(e.name, "joint placement is not finite");
+    if ((e.placement.R.transpose() * e.placement.R - Mat3::Identity()).norm() > 1e-9)
+      fail(e.name, "joint placement rotation is not orthonormal");
+    const bool moving = e.type != JointType::Fixed;
+    checkInertia(e.name, e.inertia, !moving || subtree_mass[i] > 0);
+    if (moving && subtree_mass[i] <= 0) fail(e.name, "moving joint carries no mass");
+
+    Joint j;
+    j.type = e.type;
+    j.nq = jointNq(e.type);
+    j.nv = jointNv(e.type);
+    j.idx_q = m.nq;
+    j.idx_v = m.nv;
+    j.limits = e.limits;
+    if (e.type == JointType::Revolute || e.type == JointType::Continuous ||
+        e.type == JointType::Prismatic || e.type == JointType::Planar) {
+      if (!finite(e.axis) || e.axis.norm() < 1e-12) fail(e.name, "joint axis is zero or not finite");
+      j.axis = e.axis.normalized();
+    }
+    j.S = Mat6X::Zero(6, j.nv);
+    switch (e.type) {
+      case JointType::Fixed: break;
+      case JointType::Revolute: case JointType::Continuous: j.S.col(0).head<3>() = j.axis; break;
+      case JointType::Prismatic: j.S.col(0).tail<3>() = j.axis; break;
+      case JointType::Planar: {
+        // Any orthonormal pair spanning the plane; t₁ × t₂ = axis.
+        j.t1 = j.axis.unitOrthogonal();
+        j.t2 = j.axis.cross(j.t1);
+        j.S.col(0).tail<3>() = j.t1;
+        j.S.col(1).tail<3>() = j.t2;
+        j.S.col(2).head<3>() = j.axis;
+        break;
+      }
+      case JointType::Floating: j.S = Mat6::Identity(); break;
+      case JointType::Ball: j.S.topRows<3>() = Mat3::Identity(); break;
+    }
+    m.nq += j.nq;
+    m.nv += j.nv;
+    m.parent.push_back(e.parent);
+    m.placement.push_back(e.placement);
+    m.joints.push_back(j);
+    m.inertias.push_back(e.inertia);
+    m.spatial_inertia.push_back(e.inertia.matrix());
+    m.body_names.push_back(e.name);
+    m.joint_names.push_back(e.joint_name);
+    if (e.parent >= 0) m.children[e.parent].push_back(i);
+    for (int k = 0; k < j.nv; ++k) m.body_of_v.push_back(i);
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < i; ++k)
+      if (m.joint_names[k] == m.joint_names[i]) fail(m.body_names[i], "joint name '" + m.joint_names[i] + "' is used twice");
+    std::vector<int> path;
+    for (int b = i; b >= 0; b = m.parent[b]) path.push_back(b);
+    m.support.push_back(path);
+  }
+  return m;
+}
+
+}  // namespace appell

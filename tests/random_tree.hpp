@@ -1,0 +1,61 @@
+// Random kinematic trees for tests and benchmarks: every joint type, random
+// placements and inertias (physically valid), fixed or floating base.
+#pragma once
+
+#include <appell/appell.hpp>
+
+#include <random>
+
+namespace appell::test {
+
+inline Inertia randomInertia(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.2, 2.0), c(-0.3, 0.3);
+  // Principal moments from a random box (always satisfies the triangle inequality).
+  const double m = u(rng), a = u(rng), b = u(rng), d = u(rng);
+  Vec3 moments(m * (b * b + d * d) / 12, m * (a * a + d * d) / 12, m * (a * a + b * b) / 12);
+  const Mat3 R = Quat::UnitRandom().toRotationMatrix();
+  return {m, Vec3(c(rng), c(rng), c(rng)), R * moments.asDiagonal() * R.transpose()};
+}
+
+inline SE3 randomPlacement(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  std::normal_distribution<double> g;
+  SE3 X;
+  X.R = Quat(Eigen::Vector4d(g(rng), g(rng), g(rng), g(rng)).normalized()).toRotationMatrix();
+  X.p = Vec3(u(rng), u(rng), u(rng));
+  return X;
+}
+
+inline Vec3 randomUnit(std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  return Vec3(g(rng), g(rng), g(rng)).normalized();
+}
+
+/// A random tree of n bodies; body i's parent is uniform in [−1 or 0, i−1].
+/// Joint types cycle through all moving types (plus a few fixed joints).
+inline Model randomTree(int n, bool floating_base, std::mt19937& rng) {
+  static constexpr JointType kinds[] = {JointType::Revolute, JointType::Prismatic,
+                                        JointType::Ball, JointType::Continuous,
+                                        JointType::Planar, JointType::Floating, JointType::Fixed};
+  ModelBuilder b;
+  for (int i = 0; i < n; ++i) {
+    int parent = -1;
+    JointType type = floating_base ? JointType::Floating : JointType::Revolute;
+    if (i > 0) {
+      parent = std::uniform_int_distribution<int>(floating_base ? 0 : -1, i - 1)(rng);
+      type = kinds[std::uniform_int_distribution<int>(0, 6)(rng)];
+    }
+    b.addBody("body" + std::to_string(i), parent, randomPlacement(rng), type, randomUnit(rng),
+              randomInertia(rng));
+  }
+  return b.build();
+}
+
+inline VecX randomVector(int n, std::mt19937& rng, double scale = 1.0) {
+  std::uniform_real_distribution<double> u(-scale, scale);
+  VecX x(n);
+  for (int i = 0; i < n; ++i) x[i] = u(rng);
+  return x;
+}
+
+}  // namespace appell::test
