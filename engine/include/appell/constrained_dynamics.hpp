@@ -1,0 +1,64 @@
+// Constrained forward dynamics: the interface every formulation implements.
+//
+//   M v̇ + h = τ + Aᵀλ,      A v̇ + abias = 0          (DESIGN.md §1)
+//
+// Three formulations give the same v̇ and the same reaction Aᵀλ:
+//   Multipliers  dense KKT (reference)                       kkt.hpp
+//   Appell       dense null-space / Maggi equations          appell_maggi.hpp
+//   Tree         Gauss' principle by dynamic programming on
+//                the kinematic tree, O(n + m) (the default)  tree_solver.hpp
+// With redundant rows λ is not unique: every solver returns the minimum-norm λ
+// and counts the redundant rows. Inconsistent rows (no v̇ satisfies them) are an
+// error, reported in the result — never a silently wrong v̇.
+#pragma once
+
+#include <appell/constraint_set.hpp>
+
+#include <memory>
+#include <string>
+
+namespace appell {
+
+enum class Formulation { Tree, Multipliers, Appell };
+const char* toString(Formulation f);  ///< "tree", "kkt", "appell"
+/// Parses "tree", "kkt"/"multipliers", "appell"/"maggi"; throws std::invalid_argument otherwise.
+Formulation formulationFromString(const std::string& name);
+
+struct SolverOptions {
+  double rank_abs_tol = 1e-10;   ///< absolute rank tolerance on equilibrated rows
+  double rank_rel_tol = 1e-10;   ///< relative rank tolerance
+  double consistency_tol = 1e-8; ///< residual above which redundant rows are inconsistent
+};
+
+struct ConstrainedResult {
+  VecX vdot;                 ///< nv
+  VecX lambda;               ///< m, one multiplier per row (minimum norm)
+  VecX reaction;             ///< nv, Aᵀλ
+  int rank = 0;              ///< rank of A
+  int redundant = 0;         ///< m − rank
+  bool ok = true;
+  std::string error;         ///< why !ok (inconsistent rows, singular geometry, …)
+};
+
+class ConstrainedSolver {
+ public:
+  virtual ~ConstrainedSolver() = default;
+  virtual Formulation formulation() const = 0;
+  /// Accelerations and reactions at (t, q, v) under joint forces τ (gravity from
+  /// the model). `cdata` must hold evaluateConstraints(t, q, v); `data` is workspace.
+  virtual void solve(const Model& model, Data& data, const ConstraintList& constraints,
+                     ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
+                     ConstrainedResult& out) = 0;
+  /// Impulse solve for drift control: v ← argmin ‖v⁺ − v‖_M subject to A v⁺ + b = 0,
+  /// with A, b from `cdata` (evaluated at q). Writes the impulses (m) to `impulse`.
+  /// Returns false (v untouched) when the rows are inconsistent.
+  virtual bool projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,
+                               ConstraintData& cdata, const VecX& q, VecX& v, VecX& impulse) = 0;
+};
+
+/// Builds the solver for a formulation, with its workspace sized for this system.
+std::unique_ptr<ConstrainedSolver> makeSolver(Formulation f, const Model& model,
+                                              const ConstraintList& constraints,
+                                              const SolverOptions& options = {});
+
+}  // namespace appell
