@@ -1,0 +1,95 @@
+// Contact constraints between one body's shape and a world support.
+//
+// Every row is a material-point velocity row or an angular-velocity row
+// (constraint.hpp): for a unit direction t(q, t) and the body point w(q, t)
+// now in contact,
+//      tᵀ (V_B(w) − V_S(w, t)) = 0          V_B(w) = v_O + ω × w
+//   row      W = [w × t; t],   b = −tᵀ V_S(w, t)
+//   accel    W·a + κ = 0,
+//            κ = ṫᵀ(V_B(w) − V_S(w)) + tᵀ(ω × ẇ) − tᵀ(A_lin + A_ang × w + Ω × ẇ)
+// where ẇ is the velocity of the geometric contact point (contact_geometry.hpp)
+// and [A_ang; A_lin] the support's spatial acceleration. The spin row is
+//      nᵀ(ω − Ω) = 0:  W = [n; 0], b = −nᵀΩ, κ = ṅᵀ(ω − Ω) − nᵀ A_ang.
+// The normal row is the time derivative of the signed gap, so the position
+// projection can drive the gap to zero.
+//
+// Rows per kind (in this order):
+//   Rolling               tangent1, tangent2, normal
+//   RollingWithoutSpin    tangent1, tangent2, normal, spin
+//   KnifeEdge             lateral, normal
+//   Sliding               normal
+#pragma once
+
+#include <appell/constraint.hpp>
+#include <appell/contact_geometry.hpp>
+
+#include <memory>
+
+namespace appell {
+
+enum class ContactKind { Rolling, RollingWithoutSpin, KnifeEdge, Sliding };
+
+const char* toString(ContactKind kind);
+/// Parses "rolling", "rolling_without_spin" (or "rubber"), "knife_edge",
+/// "sliding"; throws std::invalid_argument naming the text otherwise.
+ContactKind contactKindFromString(const std::string& text);
+
+struct ContactOptions {
+  std::string name;                 ///< empty: "<kind>:<body>:<support>"
+  /// Knife edges on a PointShape: the blade direction, body frame (any length
+  /// > 0). Disks and tori use their wheel plane instead (must stay zero).
+  Vec3 blade_direction = Vec3::Zero();
+  GeometryOptions geometry;
+};
+
+/// One body's smooth shape against a world support. The kinds differ only in
+/// which rows they write.
+class ShapeContact : public Constraint {
+ public:
+  ShapeContact(ContactKind kind, int body, Shape shape, Support support,
+               const ContactOptions& options);
+
+  const std::string& name() const override { return name_; }
+  int rows() const override { return rows_; }
+  int bodyA() const override { return body_; }
+  std::string rowLabel(int k) const override;
+  bool holonomic(int k) const override;
+  void reserve(const Model& model, RowBlock& block) const override;
+  void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
+                RowBlock& out) const override;
+
+  /// The same rows from the body's world pose and world spatial velocity
+  /// directly (what evaluate() does after reading data.oMi and data.v).
+  void evaluateAt(const SE3& body_pose, const Vec6& body_velocity, double t,
+                  RowBlock& out) const;
+  /// The geometry alone at the given state.
+  void geometry(const SE3& body_pose, const Vec6& body_velocity, double t,
+                ContactGeometry& out) const;
+
+  ContactKind kind() const { return kind_; }
+  const Shape& shape() const { return shape_; }
+  const Support& support() const { return support_; }
+  /// Knife edge: the unit blade direction (body frame); zero otherwise.
+  const Vec3& bladeDirection() const { return blade_; }
+
+ private:
+  ContactKind kind_;
+  int body_;
+  Shape shape_;
+  Support support_;
+  Vec3 blade_ = Vec3::Zero();
+  GeometryOptions geometry_options_;
+  int rows_ = 0;
+  std::string name_;
+};
+
+/// Builds a contact from a declarative description. Throws std::invalid_argument
+/// with the contact's name and the reason: a shape that cannot roll (box,
+/// cylinder, mesh, point) for rolling kinds, a knife edge without a blade (zero
+/// direction on a point; a sphere or ellipsoid has no blade), a shape that does
+/// not fit its bowl, a negative body index, bad shape or support parameters.
+std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,
+                                          const Support& support,
+                                          const ContactOptions& options = {});
+
+}  // namespace appell

@@ -1,0 +1,66 @@
+// Dispatch over the support surface, and the pieces every pair shares:
+// the contact point from the Gauss map and the tangent frame with its rates.
+#include "geometry_internal.hpp"
+
+namespace appell {
+
+namespace detail {
+
+void markSingular(ContactGeometry& out, const char* reason) {
+  out.singular = true;
+  out.reason = reason;
+  out.point_rate.setZero();
+  out.normal_rate.setZero();
+  out.t1_rate.setZero();
+  out.t2_rate.setZero();
+}
+
+void finishPoint(const SE3& pose, const Twist& body, const GaussPoint& g, const Vec3& mdot,
+                 ContactGeometry& out) {
+  out.point_body = g.y;
+  out.point = pose.apply(g.y);
+  // The geometric contact point moves with the body (material velocity) and
+  // slides over the body's surface as the normal turns: d/dt σ(m) = Σ ṁ.
+  out.point_rate = body.at(out.point) + pose.R * (g.Sigma * mdot);
+  out.support_point = out.point - out.gap * out.normal;
+}
+
+void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out) {
+  const Vec3& n = out.normal;
+  const Vec3& nd = out.normal_rate;
+  // u = (1 − n nᵀ) e,  u̇ = ė − ṅ (n·e) − n (ṅ·e + n·ė),  ṫ1 = (1 − t1 t1ᵀ) u̇ / |u|.
+  const Vec3 u = e - n * n.dot(e);
+  const double len = u.norm();
+  out.t1 = u / len;
+  const Vec3 ud = edot - nd * n.dot(e) - n * (nd.dot(e) + n.dot(edot));
+  out.t1_rate = (ud - out.t1 * out.t1.dot(ud)) / len;
+  out.t2 = n.cross(out.t1);
+  out.t2_rate = nd.cross(out.t1) + n.cross(out.t1_rate);
+}
+
+}  // namespace detail
+
+void contactGeometry(const Shape& shape, const SupportSurface& surface,
+                     const SupportState& support, const SE3& body_pose,
+                     const Vec6& body_velocity, ContactGeometry& out,
+                     const GeometryOptions& options) {
+  out.singular = false;
+  out.reason = nullptr;
+  out.iterations = 0;
+  if (!isSmoothContactShape(shape)) {
+    out = ContactGeometry{};
+    detail::markSingular(out, "collision-only shape has no smooth contact point");
+    return;
+  }
+  std::visit(detail::Overloaded{
+                 [&](const Plane& p) {
+                   detail::planeGeometry(shape, p, support, body_pose, body_velocity, out, options);
+                 },
+                 [&](const SphereSurface& s) {
+                   detail::sphereSurfaceGeometry(shape, s, support, body_pose, body_velocity, out,
+                                                 options);
+                 }},
+             surface);
+}
+
+}  // namespace appell

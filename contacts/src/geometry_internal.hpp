@@ -1,0 +1,51 @@
+// Private pieces shared by the contact-geometry sources.
+#pragma once
+
+#include <appell/contact_geometry.hpp>
+
+namespace appell::detail {
+
+template <class... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
+/// World spatial velocity split into its parts.
+struct Twist {
+  Vec3 w, v;  ///< ω and v_O
+  explicit Twist(const Vec6& V) : w(V.head<3>()), v(V.tail<3>()) {}
+  Vec3 at(const Vec3& x) const { return v + w.cross(x); }
+};
+
+/// Marks `out` singular with a static reason; keeps the finite values already there
+/// and zeroes the rates (they are unusable there).
+void markSingular(ContactGeometry& out, const char* reason);
+
+/// Fills point, point_body and point_rate from the body-frame normal m, its rate
+/// ṁ and the Gauss point at m:  x = R y + p,  ẋ = V_B(x) + R Σ ṁ.
+void finishPoint(const SE3& pose, const Twist& body, const GaussPoint& g, const Vec3& mdot,
+                 ContactGeometry& out);
+
+/// t1 = normalize((1 − n nᵀ) e), t2 = n × t1 and their rates, for a reference
+/// direction e(t) with rate ė (needs n, ṅ in `out`). Requires |(1 − n nᵀ) e| well
+/// above zero (callers pick e so that it is ≥ 1/√2).
+void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out);
+
+void planeGeometry(const Shape& shape, const Plane& plane, const SupportState& S, const SE3& pose,
+                   const Vec6& V, ContactGeometry& out, const GeometryOptions& opt);
+
+void sphereSurfaceGeometry(const Shape& shape, const SphereSurface& sphere, const SupportState& S,
+                           const SE3& pose, const Vec6& V, ContactGeometry& out,
+                           const GeometryOptions& opt);
+
+/// Body-frame outward normal m of the ellipsoid point nearest to (outside = true)
+/// or farthest from (outside = false) the body-frame point s, by Newton's method
+/// on the tangential residual (1 − m mᵀ)(σ(m) − s) = 0. Returns false (with a
+/// static reason) when it does not converge or the extremum is not the right kind.
+bool ellipsoidExtremalNormal(const Ellipsoid& e, const Vec3& s, bool outside,
+                             const GeometryOptions& opt, Vec3& m, int& iterations,
+                             const char*& reason);
+
+}  // namespace appell::detail

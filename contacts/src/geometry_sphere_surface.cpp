@@ -1,0 +1,160 @@
+// A smooth shape on the outside of a sphere (nearest point to its centre C)
+// or inside it (a bowl: the farthest point from C).
+//
+// Body frame: s = Rᵀ(C − p), contact point y = σ(m) with y − s = ε d m
+// (ε = −1 outside: the outward normal m points at C; ε = +1 inside: away
+// from it), d = |y − s|. Differentiating,
+//     Σ ṁ − ṡ = ε ḋ m + ε d ṁ   ⇒   (Σ − ε d)|_{m⊥} ṁ = (1 − m mᵀ) ṡ,
+// with ṡ = Rᵀ(V_S(C) − V_B(C)) the velocity of C relative to the body.
+// Outside, Σ + d is positive definite on m⊥ for any convex part. Inside it is
+// Σ − d, which must be negative definite: every radius of curvature at the
+// contact below d — the local form of "the shape fits the bowl"; its failure
+// is reported. n = −R m, ṅ = ω × n − R ṁ. Gap: d − R_s outside, R_s − d inside.
+#include "geometry_internal.hpp"
+
+#include <Eigen/Eigenvalues>
+
+namespace appell::detail {
+
+namespace {
+
+// Normal for shapes whose extreme point is closed-form. Returns false with a reason.
+bool closedFormNormal(const Shape& shape, const Vec3& s, bool outside, double tol, Vec3& m,
+                      const char*& reason) {
+  auto fromCentre = [&](const Vec3& c, double size) {
+    const Vec3 dir = outside ? Vec3(s - c) : Vec3(c - s);
+    const double len = dir.norm();
+    if (len <= tol * (size + s.norm())) {
+      reason = "the support sphere's centre coincides with the shape's centre: every direction "
+               "is a contact normal";
+      m = Vec3::UnitZ();
+      return false;
+    }
+    m = dir / len;
+    return true;
+  };
+  return std::visit(
+      Overloaded{
+          [&](const PointShape& x) { return fromCentre(x.position, 1.0); },
+          [&](const Sphere& x) { return fromCentre(x.centre, x.radius); },
+          [&](const SphericalCap& x) { return fromCentre(x.centre, x.radius); },
+          [&](const auto& wheel) -> bool {
+            // Disk or torus: the tube centre nearest C (outside) or farthest from it
+            // (inside) lies on the centre circle, in the direction of C's projection.
+            Vec3 c, a;
+            double Rm;
+            if constexpr (std::is_same_v<std::decay_t<decltype(wheel)>, Disk>) {
+              c = wheel.centre;
+              a = wheel.axis;
+              Rm = wheel.radius;
+            } else if constexpr (std::is_same_v<std::decay_t<decltype(wheel)>, Torus>) {
+              c = wheel.centre;
+              a = wheel.axis;
+              Rm = wheel.major;
+            } else {
+              reason = "shape has no closed-form contact";
+              return false;
+            }
+            const Vec3 w = (s - c) - a * a.dot(s - c);
+            const double wl = w.norm();
+            m = -a;
+            if (wl <= tol * (Rm + s.norm())) {
+              reason = "the support sphere's centre lies on the wheel's axis: every rim point is "
+                       "equally near, no unique contact";
+              return false;
+            }
+            const Vec3 u = outside ? Vec3(w / wl) : Vec3(-w / wl);
+            const Vec3 k = c + Rm * u;  // tube centre at the contact
+            const Vec3 dir = outside ? Vec3(s - k) : Vec3(k - s);
+            const double len = dir.norm();
+            if (len <= tol * (Rm + s.norm())) {
+              reason = "the support sphere's centre lies on the wheel's rim circle";
+              return false;
+            }
+            m = dir / len;
+            // The Gauss map covers the outer (convex) part of the wheel only.
+            if ((m - a * a.dot(m)).dot(u) <= 0) {
+              reason = "contact on the inner (non-convex) side of the wheel: the sphere pokes "
+                       "through the wheel's hole";
+              return false;
+            }
+            return true;
+          }},
+      shape);
+}
+
+}  // namespace
+
+void sphereSurfaceGeometry(const Shape& shape, const SphereSurface& sphere, const SupportState& S,
+                           const SE3& pose, const Vec6& V, ContactGeometry& out,
+                           const GeometryOptions& opt) {
+  const Twist body(V), sup(S.V);
+  const bool outside = sphere.side == SphereSurface::Side::Outside;
+  const double eps = outside ? -1.0 : 1.0;
+  const Vec3 C = S.pose.apply(sphere.centre);
+  const Vec3 s = pose.R.transpose() * (C - pose.p);
+  const Vec3 sdot = pose.R.transpose() * (sup.at(C) - body.at(C));
+
+  Vec3 m;
+  const char* reason = nullptr;
+  bool ok;
+  if (const auto* el = std::get_if<Ellipsoid>(&shape)) {
+    ok = ellipsoidExtremalNormal(*el, s, outside, opt, m, out.iterations, reason);
+    if (!ok) m = (outside ? Vec3(s - el->centre) : Vec3(el->centre - s)).normalized();
+    if (!m.allFinite()) m = Vec3::UnitZ();
+  } else {
+    ok = closedFormNormal(shape, s, outside, opt.singular_tol, m, reason);
+  }
+  const GaussPoint g = inverseGaussMap(shape, m, opt.singular_tol);
+  const double d = eps * m.dot(g.y - s);
+
+  out.normal = -(pose.R * m);
+  out.gap = outside ? d - sphere.radius : sphere.radius - d;
+
+  // ṁ on the tangent plane of m: 2×2 system in the basis (e1, e2).
+  Eigen::Matrix<double, 3, 2> E;
+  E.col(0) = m.unitOrthogonal();
+  E.col(1) = m.cross(E.col(0));
+  const Eigen::Matrix2d B = E.transpose() * (g.Sigma - eps * d * Mat3::Identity()) * E;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(B);
+  const Eigen::Vector2d lam = es.eigenvalues();
+  Vec3 mdot = Vec3::Zero();
+  const char* bad = nullptr;
+  if (ok && !g.singular) {
+    if (!(d > 0)) {
+      bad = "the support sphere's centre is inside the body: no unique contact";
+    } else if (outside ? !(lam.minCoeff() > opt.singular_tol * d)
+                       : !(lam.maxCoeff() < -opt.singular_tol * d)) {
+      bad = outside ? "degenerate curvature at the contact (shape not convex there)"
+                    : "the shape does not fit the bowl here: a radius of curvature at the contact "
+                      "reaches the distance to the bowl centre";
+    } else if (!outside) {
+      // Ellipsoids: uniqueness of the farthest point (Blaschke's rolling theorem)
+      // needs every radius of curvature below d.
+      if (const auto* el = std::get_if<Ellipsoid>(&shape)) {
+        const double amax = el->semi_axes.maxCoeff(), amin = el->semi_axes.minCoeff();
+        if (!(amax * amax / amin < d))
+          bad = "no unique contact in the bowl: the ellipsoid's largest radius of curvature "
+                "a_max²/a_min is not below its distance to the bowl centre";
+      }
+    }
+    if (!bad) {
+      const Eigen::Vector2d rhs = E.transpose() * sdot;
+      mdot = E * es.eigenvectors() *
+             (es.eigenvectors().transpose() * rhs).cwiseQuotient(lam);
+    }
+  }
+  out.normal_rate = body.w.cross(out.normal) - pose.R * mdot;
+  finishPoint(pose, body, g, mdot, out);
+
+  // Reference direction fixed in the support frame, switched where it is near the normal.
+  Vec3 e = S.pose.R.col(0);
+  if ((e - out.normal * out.normal.dot(e)).squaredNorm() < 0.5) e = S.pose.R.col(1);
+  tangentFrame(e, sup.w.cross(e), out);
+
+  if (!ok) markSingular(out, reason);
+  else if (g.singular) markSingular(out, g.reason);
+  else if (bad) markSingular(out, bad);
+}
+
+}  // namespace appell::detail

@@ -1,0 +1,209 @@
+// ShapeContact: one body's smooth shape against a world support; validation
+// at construction, rows at evaluation (no allocation there).
+#include <appell/contacts.hpp>
+
+#include "contact_kinds.hpp"
+#include "geometry_internal.hpp"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace appell {
+
+namespace {
+
+int rowCount(ContactKind kind) {
+  switch (kind) {
+    case ContactKind::Rolling: return 3;
+    case ContactKind::RollingWithoutSpin: return 4;
+    case ContactKind::KnifeEdge: return 2;
+    case ContactKind::Sliding: return 1;
+  }
+  return 0;
+}
+
+bool isWheel(const Shape& s) {
+  return std::holds_alternative<Disk>(s) || std::holds_alternative<Torus>(s);
+}
+
+}  // namespace
+
+const char* toString(ContactKind kind) {
+  switch (kind) {
+    case ContactKind::Rolling: return "rolling";
+    case ContactKind::RollingWithoutSpin: return "rolling_without_spin";
+    case ContactKind::KnifeEdge: return "knife_edge";
+    case ContactKind::Sliding: return "sliding";
+  }
+  return "?";
+}
+
+ContactKind contactKindFromString(const std::string& text) {
+  if (text == "rolling") return ContactKind::Rolling;
+  if (text == "rolling_without_spin" || text == "rolling-without-spin" || text == "rubber")
+    return ContactKind::RollingWithoutSpin;
+  if (text == "knife_edge" || text == "knife-edge" || text == "knife") return ContactKind::KnifeEdge;
+  if (text == "sliding") return ContactKind::Sliding;
+  throw std::invalid_argument("unknown contact kind '" + text +
+                              "' (expected rolling, rolling_without_spin, knife_edge or sliding)");
+}
+
+ShapeContact::ShapeContact(ContactKind kind, int body, Shape shape, Support support,
+                           const ContactOptions& options)
+    : kind_(kind),
+      body_(body),
+      shape_(std::move(shape)),
+      support_(std::move(support)),
+      geometry_options_(options.geometry),
+      rows_(rowCount(kind)) {
+  if (options.name.empty()) {
+    std::ostringstream s;
+    s << toString(kind) << "(body " << body << ", " << shapeName(shape_) << " on "
+      << support_.name << ")";
+    name_ = s.str();
+  } else {
+    name_ = options.name;
+  }
+  auto fail = [&](const std::string& why) {
+    throw std::invalid_argument("contact '" + name_ + "': " + why);
+  };
+  if (body < 0) fail("body index must be ≥ 0 (the world cannot carry a contact shape)");
+  try {
+    validateShape(shape_);
+    validateSupport(support_);
+  } catch (const std::invalid_argument& e) {
+    fail(e.what());
+  }
+  if (auto* p = std::get_if<Plane>(&support_.surface)) p->normal.normalize();
+  std::string why;
+  switch (kind) {
+    case ContactKind::Rolling:
+    case ContactKind::RollingWithoutSpin:
+      if (!canRoll(shape_, &why)) fail(why);
+      break;
+    case ContactKind::KnifeEdge:
+      if (std::holds_alternative<PointShape>(shape_)) {
+        const Vec3& b = options.blade_direction;
+        if (!b.allFinite() || b.norm() < 1e-12)
+          fail("knife edge on a point needs a non-zero blade direction");
+        blade_ = b.normalized();
+      } else if (isWheel(shape_)) {
+        if (options.blade_direction.norm() != 0)
+          fail("a disk or torus knife edge uses its wheel plane as the blade; leave "
+               "blade_direction unset");
+        blade_ = std::holds_alternative<Disk>(shape_) ? std::get<Disk>(shape_).axis
+                                                      : std::get<Torus>(shape_).axis;
+      } else {
+        fail(std::string("a knife edge needs a blade: a point with a blade direction, or a disk "
+                         "or torus wheel (got a ") +
+             shapeName(shape_) + ")");
+      }
+      break;
+    case ContactKind::Sliding:
+      if (!isSmoothContactShape(shape_))
+        fail(std::string("a ") + shapeName(shape_) +
+             " has no smooth contact point; sliding needs a point or a smooth convex shape");
+      break;
+  }
+  if (const auto* sp = std::get_if<SphereSurface>(&support_.surface)) {
+    if (sp->side == SphereSurface::Side::Inside && !fitsInBowl(shape_, sp->radius, &why))
+      fail("does not fit the bowl '" + support_.name + "': " + why);
+  }
+}
+
+std::string ShapeContact::rowLabel(int k) const {
+  switch (kind_) {
+    case ContactKind::Rolling:
+    case ContactKind::RollingWithoutSpin: {
+      static const char* labels[] = {"tangent1", "tangent2", "normal", "spin"};
+      return labels[k];
+    }
+    case ContactKind::KnifeEdge: return k == 0 ? "lateral" : "normal";
+    case ContactKind::Sliding: return "normal";
+  }
+  return "?";
+}
+
+bool ShapeContact::holonomic(int k) const {
+  switch (kind_) {
+    case ContactKind::Rolling:
+    case ContactKind::RollingWithoutSpin: return k == 2;
+    case ContactKind::KnifeEdge: return k == 1;
+    case ContactKind::Sliding: return k == 0;
+  }
+  return false;
+}
+
+void ShapeContact::reserve(const Model& model, RowBlock& block) const {
+  if (body_ >= model.nbodies)
+    throw std::invalid_argument("contact '" + name_ + "': body index " + std::to_string(body_) +
+                                " is out of range (the model has " +
+                                std::to_string(model.nbodies) + " bodies)");
+  Constraint::reserve(model, block);
+  block.m = rows_;
+  block.Wa.setZero(rows_, 6);
+  block.Wb.setZero(rows_, 6);
+  block.b.setZero(rows_);
+  block.kappa.setZero(rows_);
+  block.gap.setZero(rows_);
+  // Singular reasons are static texts shorter than this: assigning one later
+  // does not allocate.
+  block.singular_reason.reserve(256);
+}
+
+void ShapeContact::geometry(const SE3& body_pose, const Vec6& body_velocity, double t,
+                            ContactGeometry& out) const {
+  const SupportState S = supportState(support_.motion, t);
+  contactGeometry(shape_, support_.surface, S, body_pose, body_velocity, out, geometry_options_);
+}
+
+void ShapeContact::evaluateAt(const SE3& body_pose, const Vec6& body_velocity, double t,
+                              RowBlock& out) const {
+  const SupportState S = supportState(support_.motion, t);
+  ContactGeometry g;
+  contactGeometry(shape_, support_.surface, S, body_pose, body_velocity, g, geometry_options_);
+  out.m = rows_;
+  out.Wa.resize(rows_, 6);
+  out.Wb.resize(rows_, 6);
+  out.b.resize(rows_);
+  out.kappa.resize(rows_);
+  out.gap.resize(rows_);
+  const char* reason = g.singular ? g.reason : nullptr;
+  switch (kind_) {
+    case ContactKind::Rolling:
+    case ContactKind::RollingWithoutSpin:
+      detail::writeRollingRows(g, body_velocity, S, kind_ == ContactKind::RollingWithoutSpin, out);
+      break;
+    case ContactKind::KnifeEdge: {
+      const char* r =
+          detail::writeKnifeEdgeRows(g, body_pose, body_velocity, S, blade_, isWheel(shape_),
+                                     geometry_options_.singular_tol, out);
+      if (!reason) reason = r;
+      break;
+    }
+    case ContactKind::Sliding:
+      detail::writeSlidingRows(g, body_velocity, S, out);
+      break;
+  }
+  out.frame.point = g.point;
+  out.frame.normal = g.normal;
+  out.frame.t1 = g.t1;
+  out.frame.t2 = g.t2;
+  out.frame.gap = g.gap;
+  out.singular = reason != nullptr;
+  if (reason) out.singular_reason.assign(reason);
+  else out.singular_reason.clear();
+}
+
+void ShapeContact::evaluate(const Model&, const Data& data, double t, const VecX&, const VecX&,
+                            RowBlock& out) const {
+  const SE3& pose = data.oMi[body_];
+  evaluateAt(pose, pose.act(data.v[body_]), t, out);
+}
+
+std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,
+                                          const Support& support, const ContactOptions& options) {
+  return std::make_shared<ShapeContact>(kind, body, shape, support, options);
+}
+
+}  // namespace appell
