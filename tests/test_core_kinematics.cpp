@@ -106,7 +106,9 @@ TEST(CoreKinematics, VelocitiesAndJacobiansMatchFiniteDifferences) {
       EXPECT_LT((J * c.v - pv).norm(), 1e-13 * scale) << "body " << body;
       // Columns of joints off the body's path are exactly zero.
       for (int k = 0; k < model.nv; ++k) {
-        if (!model.isAncestor(model.body_of_v[k], body)) EXPECT_EQ(J.col(k).norm(), 0.0);
+        if (!model.isAncestor(model.body_of_v[k], body)) {
+          EXPECT_EQ(J.col(k).norm(), 0.0);
+        }
       }
 
       // World spatial velocity [ω; v_O], v_O = ȯ − ω × o for the body origin o.
