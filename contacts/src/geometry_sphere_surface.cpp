@@ -100,8 +100,10 @@ void sphereSurfaceGeometry(const Shape& shape, const SphereSurface& sphere, cons
   bool ok;
   if (const auto* el = std::get_if<Ellipsoid>(&shape)) {
     ok = ellipsoidExtremalNormal(*el, s, outside, opt, m, out.iterations, reason);
-    if (!ok) m = (outside ? Vec3(s - el->centre) : Vec3(el->centre - s)).normalized();
-    if (!m.allFinite()) m = Vec3::UnitZ();
+    if (!ok) {  // a finite stand-in for the report
+      const Vec3 dir = outside ? Vec3(s - el->centre) : Vec3(el->centre - s);
+      m = dir.norm() > 0 && dir.allFinite() ? Vec3(dir.normalized()) : Vec3(Vec3::UnitZ());
+    }
   } else {
     ok = closedFormNormal(shape, s, outside, opt.singular_tol, m, reason);
   }
