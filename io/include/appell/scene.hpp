@@ -1,0 +1,108 @@
+// A loaded scene: the model, its contacts as constraints, the initial state,
+// the geometry of every link and the default simulation settings.
+//
+// A Scene is what `loadScene` (urdf.hpp) returns from a URDF with an
+// `<appell>` block (docs/scene-format.md). Everything in it is plain data: the
+// engine, the solvers and the writers read it; nothing in it refers back to
+// the file, except `source` for messages.
+#pragma once
+
+#include <appell/constraint.hpp>
+#include <appell/constraint_set.hpp>
+#include <appell/contacts.hpp>
+#include <appell/model.hpp>
+
+#include <array>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace appell {
+
+/// Error in a scene description. The message names the file, the element
+/// (with its line when the XML parser gives one) and the reason, as
+///   "robot.urdf:12: <joint name=\"j1\">: axis is zero".
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Triangles of a mesh, already scaled, in the mesh file's own frame.
+struct TriangleMesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> triangles;  ///< indices into `vertices`
+  std::string source;                         ///< resolved file path
+};
+
+enum class GeometryType { Box, Cylinder, Sphere, Mesh };
+const char* toString(GeometryType type);
+
+/// One `<visual>` or `<collision>` element of a link.
+struct Geometry {
+  GeometryType type = GeometryType::Sphere;
+  std::string name;               ///< the element's name attribute (may be empty)
+  SE3 origin;                     ///< pose of the geometry in the link frame
+  Vec3 box_size = Vec3::Zero();   ///< box: full edge lengths along x, y, z
+  double radius = 0;              ///< sphere, cylinder
+  double length = 0;              ///< cylinder: along its local z
+  std::string mesh_uri;           ///< mesh: the filename as written
+  std::string mesh_path;          ///< mesh: resolved absolute path
+  Vec3 mesh_scale = Vec3::Ones(); ///< mesh: the scale applied to `mesh`
+  std::shared_ptr<const TriangleMesh> mesh;  ///< mesh: triangles (scaled); null if not loaded
+};
+
+/// Geometry of one link. Links map one-to-one to model bodies.
+struct LinkGeometry {
+  std::string link;
+  int body = -1;
+  std::vector<Geometry> visual;
+  std::vector<Geometry> collision;
+};
+
+/// One declared contact, index-aligned with Scene::constraints. The shape is
+/// in the body frame (a link's frame: every link is a body).
+struct ContactInfo {
+  std::string name;
+  std::string link;
+  int body = -1;
+  ContactKind kind = ContactKind::Rolling;
+  std::string support;            ///< Support::name
+  int support_index = -1;         ///< into Scene::supports
+  Shape shape;
+  Vec3 blade_direction = Vec3::Zero();  ///< knife edge on a point: body frame
+  /// Friction coefficient for the friction check (∞: not checked).
+  double mu = std::numeric_limits<double>::infinity();
+  /// Where the shape came from: "explicit" or "collision[k] (<type>)".
+  std::string shape_source;
+  int line = 0;                   ///< line of the <contact> element
+};
+
+/// Defaults for running the scene; the command line may override them.
+struct SimulationSettings {
+  std::string integrator = "rk4";  ///< integratorFromString() accepts it
+  double dt = 1e-3;                ///< fixed step (and first step of adaptive methods)
+  double tol = 1e-8;               ///< adaptive methods: relative tolerance
+  double duration = 1.0;
+  std::string formulation = "tree";  ///< "tree" | "kkt" | "appell"
+};
+
+struct Scene {
+  Model model;
+  /// One constraint per contact, in the order of `contacts`.
+  ConstraintList constraints;
+  std::vector<ContactInfo> contacts;
+  std::vector<Support> supports;
+  VecX q0, v0;                     ///< initial state (nq, nv)
+  VecX tau;                        ///< constant generalized forces (nv), from <effort>
+  SimulationSettings settings;
+  std::vector<LinkGeometry> geometry;  ///< one per body, index = body
+  std::string source;              ///< the file the scene was loaded from
+
+  /// Index of the contact with this name, −1 if absent.
+  int contactIndex(const std::string& name) const;
+  /// Total number of constraint rows.
+  int constraintRows() const;
+};
+
+}  // namespace appell

@@ -1,0 +1,93 @@
+// Loading robots and scenes from URDF (+ meshes, + the `<appell>` block).
+//
+// The URDF conventions kept here (docs/scene-format.md has the details):
+//  - Bodies are the URDF links in depth-first order from the root (parent
+//    before child, children in document order). Every link becomes a body,
+//    including massless links attached by fixed joints (the Model accepts
+//    massless fixed attachments); no inertia is merged.
+//  - A link named `world` is the world, not a body. A joint whose parent is
+//    `world` attaches its child at the root: a fixed joint welds it, any other
+//    joint type is that joint at the root. Without a `world` link, the root
+//    link gets a floating joint named "root_joint".
+//  - The inertial origin may rotate the inertia frame: the tensor is rotated
+//    into the link frame, I_link = R I Rᵀ, and the centre of mass is its xyz.
+//  - Joint limits are kept in Model::joints[i].limits (continuous joints keep
+//    only effort and velocity limits).
+//  - Mesh files are resolved relative to the URDF's folder, as absolute paths,
+//    `file://` URIs, or `package://NAME/…` through the package search path.
+#pragma once
+
+#include <appell/scene.hpp>
+
+#include <string>
+#include <vector>
+
+namespace appell {
+
+struct LoadOptions {
+  /// Folders searched for `package://NAME/…`, before ROS_PACKAGE_PATH.
+  std::vector<std::string> package_paths;
+  /// Also search the colon-separated folders of the environment variable
+  /// ROS_PACKAGE_PATH (after `package_paths`).
+  bool use_ros_package_path = true;
+  /// Read mesh files (visual and collision). When false, mesh geometry keeps
+  /// its resolved path but no triangles, and a missing file is still an error.
+  bool load_meshes = true;
+  /// loadScene: check the initial state against the constraints (see
+  /// checkInitialState) with this tolerance; project it instead of failing
+  /// when `project_initial_state` is set.
+  bool check_initial_state = true;
+  bool project_initial_state = false;
+  double initial_state_tolerance = 1e-8;
+};
+
+/// Model only (links, joints, inertias, limits, gravity from the `<appell>`
+/// block if present). Throws SceneError.
+Model loadUrdfModel(const std::string& path, const LoadOptions& options = {});
+
+/// The whole scene. Throws SceneError; never returns a partial scene.
+Scene loadScene(const std::string& path, const LoadOptions& options = {});
+
+/// The same from a string; `base_dir` resolves relative mesh paths and
+/// `name` is used in messages (e.g. "<string>").
+Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
+                          const std::string& name = "<string>",
+                          const LoadOptions& options = {});
+
+/// Resolves a mesh URI as the loader does: `package://NAME/rest`, `file://path`,
+/// an absolute path, or a path relative to `base_dir`. Returns the absolute
+/// path; throws SceneError (naming `uri` and every folder searched) when the
+/// file does not exist.
+std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
+                            const LoadOptions& options = {});
+
+/// Folder of package NAME: the first search-path entry E with E/NAME a folder,
+/// or a folder under E (E itself included, searched depth-first up to 6
+/// levels) holding a package.xml whose <name> is NAME. Empty if none.
+std::string findPackage(const std::string& name, const LoadOptions& options = {});
+
+/// Reads a triangle mesh (STL, OBJ, Collada/DAE and the other formats assimp
+/// reads), applies node transforms and `scale`. Collada files keep their own
+/// up axis (the file's coordinates are taken as they are, as ROS tools do)
+/// and their unit. Throws SceneError for unreadable files and meshes with no
+/// triangles.
+TriangleMesh loadMesh(const std::string& path, const Vec3& scale = Vec3::Ones());
+
+/// Result of checkInitialState.
+struct InitialStateReport {
+  double velocity_residual = 0;   ///< max |A v + b| over all rows
+  double gap_residual = 0;        ///< max |g| over holonomic rows
+  bool projected = false;         ///< q0/v0 were changed
+  int iterations = 0;             ///< Newton steps of the position projection
+};
+
+/// Checks that (q0, v0) satisfies every constraint: |A v + b| and the
+/// holonomic gaps within `tol`. If not: with `project` false, throws
+/// SceneError naming the worst contact, its row and the residual; with
+/// `project` true, moves q0 onto the gaps (Gauss–Newton in the local
+/// coordinates, minimum-norm steps) and v0 onto A v + b = 0 (the M-metric
+/// projection v ← v − M⁻¹Aᵀ(A M⁻¹Aᵀ)⁺(A v + b)), then checks again and
+/// throws if that did not succeed.
+InitialStateReport checkInitialState(Scene& scene, bool project, double tol = 1e-8);
+
+}  // namespace appell

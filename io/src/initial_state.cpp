@@ -1,0 +1,126 @@
+// Is the scene's initial state on the constraint manifold? And if asked,
+// put it there: q onto the holonomic gaps, then v onto A v + b = 0.
+#include <appell/urdf.hpp>
+
+#include <appell/configuration.hpp>
+#include <appell/dynamics.hpp>
+#include <appell/kinematics.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+
+#include <cmath>
+#include <sstream>
+
+namespace appell {
+
+namespace {
+
+struct Worst {
+  double value = 0;
+  int row = -1;
+  bool gap = false;
+};
+
+Worst worstRow(const ConstraintData& cd, const VecX& v) {
+  Worst w;
+  const VecX r = cd.A * v + cd.b;
+  for (int i = 0; i < cd.m; ++i) {
+    if (std::abs(cd.gap(i)) > w.value) w = {std::abs(cd.gap(i)), i, true};
+    if (std::abs(r(i)) > w.value) w = {std::abs(r(i)), i, false};
+  }
+  return w;
+}
+
+std::string describeRow(const Scene& scene, const ConstraintData& cd, int row) {
+  const int c = cd.row_constraint[row];
+  const Constraint& con = *scene.constraints[c];
+  return "contact '" + con.name() + "' row '" + con.rowLabel(row - cd.offset[c]) + "'";
+}
+
+[[noreturn]] void singular(const Scene& scene, const ConstraintData& cd) {
+  throw SceneError(scene.source + ": initial state: the contact geometry is singular: " +
+                   cd.singular_reason);
+}
+
+}  // namespace
+
+InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
+  InitialStateReport report;
+  const Model& model = scene.model;
+  if (scene.q0.size() != model.nq || scene.v0.size() != model.nv)
+    throw SceneError(scene.source + ": initial state has the wrong size (q " +
+                     std::to_string(scene.q0.size()) + " for nq " + std::to_string(model.nq) +
+                     ", v " + std::to_string(scene.v0.size()) + " for nv " +
+                     std::to_string(model.nv) + ")");
+  if (!scene.q0.allFinite() || !scene.v0.allFinite())
+    throw SceneError(scene.source + ": initial state is not finite");
+  if (scene.constraints.empty()) return report;
+
+  Data data(model);
+  ConstraintData cd(model, scene.constraints);
+  evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
+  if (cd.singular) singular(scene, cd);
+  report.velocity_residual = velocityResidual(cd, scene.v0);
+  report.gap_residual = gapResidual(cd);
+  if (report.velocity_residual <= tol && report.gap_residual <= tol) return report;
+
+  if (!project) {
+    const Worst w = worstRow(cd, scene.v0);
+    std::ostringstream s;
+    s << scene.source << ": initial state violates the constraints: " << describeRow(scene, cd, w.row)
+      << (w.gap ? " has gap " : " has velocity residual |A v + b| = ") << w.value
+      << " (tolerance " << tol << "; max gap " << report.gap_residual
+      << ", max velocity residual " << report.velocity_residual
+      << "); fix <initial> or load with project_initial_state";
+    throw SceneError(s.str());
+  }
+
+  // Positions: Gauss–Newton on the holonomic gaps in local coordinates θ,
+  // where ∂g/∂θ at θ = 0 is the row of A (the row is ġ = A v + b and q̇ = G v).
+  VecX q = scene.q0, theta(model.nv), qn(model.nq);
+  for (int it = 0; it < 50; ++it) {
+    if (gapResidual(cd) <= 0.01 * tol) break;
+    std::vector<int> rows;
+    for (int i = 0; i < cd.m; ++i)
+      if (cd.holonomic[i]) rows.push_back(i);
+    MatX H(rows.size(), model.nv);
+    VecX g(rows.size());
+    for (int k = 0; k < static_cast<int>(rows.size()); ++k) {
+      H.row(k) = cd.A.row(rows[k]);
+      g(k) = cd.gap(rows[k]);
+    }
+    theta = -Eigen::CompleteOrthogonalDecomposition<MatX>(H).solve(g);
+    retract(model, q, theta, qn);
+    q = qn;
+    ++report.iterations;
+    evaluateConstraints(model, data, scene.constraints, cd, 0.0, q, scene.v0);
+    if (cd.singular) singular(scene, cd);
+  }
+  // Velocities: the M-metric projection onto A v + b = 0 (the impulse that
+  // removes the violation with the least kinetic energy).
+  crba(model, data, q);
+  const Eigen::LDLT<MatX> M(data.M);
+  const MatX MinvAt = M.solve(cd.A.transpose());
+  const MatX S = cd.A * MinvAt;
+  const VecX r = cd.A * scene.v0 + cd.b;
+  VecX v = scene.v0 - MinvAt * Eigen::CompleteOrthogonalDecomposition<MatX>(S).solve(r);
+  evaluateConstraints(model, data, scene.constraints, cd, 0.0, q, v);
+  if (cd.singular) singular(scene, cd);
+  report.velocity_residual = velocityResidual(cd, v);
+  report.gap_residual = gapResidual(cd);
+  report.projected = true;
+  if (report.velocity_residual > tol || report.gap_residual > tol) {
+    const Worst w = worstRow(cd, v);
+    std::ostringstream s;
+    s << scene.source << ": initial state could not be projected onto the constraints: "
+      << describeRow(scene, cd, w.row) << (w.gap ? " keeps gap " : " keeps velocity residual ")
+      << w.value << " (tolerance " << tol << ") after " << report.iterations << " Newton steps";
+    throw SceneError(s.str());
+  }
+  scene.q0 = q;
+  scene.v0 = v;
+  return report;
+}
+
+}  // namespace appell

@@ -1,0 +1,87 @@
+// Triangle meshes through assimp.
+#include <appell/urdf.hpp>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/config.h>
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <functional>
+
+namespace appell {
+
+TriangleMesh loadMesh(const std::string& path, const Vec3& scale) {
+  if (!std::filesystem::is_regular_file(path))
+    throw SceneError(path + ": mesh file not found");
+  if (!scale.allFinite() || scale.cwiseAbs().minCoeff() == 0)
+    throw SceneError(path + ": mesh scale must be finite and non-zero");
+  Assimp::Importer importer;
+  // ROS tools take a Collada file's coordinates as they are (URDF frames are
+  // z-up); assimp would otherwise rotate Z_UP files into its own y-up frame.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_Triangulate | aiProcess_SortByPType);
+  if (!scene || !scene->mRootNode) {
+    const std::string why = importer.GetErrorString();
+    // assimp refuses files whose meshes are all empty; say it the same way
+    // as for meshes made of points and lines only.
+    if (why.find("No meshes") != std::string::npos)
+      throw SceneError(path + ": mesh has no triangles (" + why + ")");
+    throw SceneError(path + ": cannot read mesh: " + why);
+  }
+
+  TriangleMesh out;
+  out.source = path;
+  // Walk the node hierarchy so that each mesh instance gets its node's
+  // transform (Collada and OBJ groups place parts with transforms).
+  std::function<void(const aiNode*, const aiMatrix4x4&)> visit = [&](const aiNode* node,
+                                                                     const aiMatrix4x4& parent) {
+    const aiMatrix4x4 T = parent * node->mTransformation;
+    for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      const aiMesh* mesh = scene->mMeshes[node->mMeshes[k]];
+      if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+      const int base = static_cast<int>(out.vertices.size());
+      for (unsigned i = 0; i < mesh->mNumVertices; ++i) {
+        const aiVector3D p = T * mesh->mVertices[i];
+        out.vertices.emplace_back(scale.x() * p.x, scale.y() * p.y, scale.z() * p.z);
+      }
+      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        const aiFace& face = mesh->mFaces[f];
+        if (face.mNumIndices != 3) continue;
+        out.triangles.push_back({base + static_cast<int>(face.mIndices[0]),
+                                 base + static_cast<int>(face.mIndices[1]),
+                                 base + static_cast<int>(face.mIndices[2])});
+      }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) visit(node->mChildren[c], T);
+  };
+  visit(scene->mRootNode, aiMatrix4x4());
+  // Weld vertices at the same position: STL repeats corners per facet and
+  // assimp keeps vertices apart when their normals differ; collision and
+  // contact code want one vertex per corner.
+  std::map<std::array<double, 3>, int> index;
+  std::vector<int> remap(out.vertices.size());
+  std::vector<Vec3> welded;
+  for (std::size_t i = 0; i < out.vertices.size(); ++i) {
+    const Vec3& v = out.vertices[i];
+    const auto [it, inserted] = index.try_emplace({v.x(), v.y(), v.z()}, static_cast<int>(welded.size()));
+    if (inserted) welded.push_back(v);
+    remap[i] = it->second;
+  }
+  out.vertices = std::move(welded);
+  std::vector<std::array<int, 3>> kept;
+  for (const auto& t : out.triangles) {
+    const std::array<int, 3> w = {remap[t[0]], remap[t[1]], remap[t[2]]};
+    if (w[0] != w[1] && w[1] != w[2] && w[0] != w[2]) kept.push_back(w);  // drop collapsed ones
+  }
+  out.triangles = std::move(kept);
+  if (out.triangles.empty()) throw SceneError(path + ": mesh has no triangles");
+  for (const Vec3& v : out.vertices)
+    if (!v.allFinite()) throw SceneError(path + ": mesh has a non-finite vertex");
+  return out;
+}
+
+}  // namespace appell

@@ -1,0 +1,114 @@
+#include <appell/output.hpp>
+
+#include <charconv>
+#include <stdexcept>
+
+namespace appell {
+
+namespace {
+
+std::vector<std::string> coordNames(JointType type, bool velocity) {
+  switch (type) {
+    case JointType::Fixed: return {};
+    case JointType::Revolute:
+    case JointType::Continuous:
+    case JointType::Prismatic: return {""};
+    case JointType::Planar:
+      return velocity ? std::vector<std::string>{".vx", ".vy", ".omega"}
+                      : std::vector<std::string>{".x", ".y", ".theta"};
+    case JointType::Floating:
+      return velocity ? std::vector<std::string>{".wx", ".wy", ".wz", ".vx", ".vy", ".vz"}
+                      : std::vector<std::string>{".x", ".y", ".z", ".qx", ".qy", ".qz", ".qw"};
+    case JointType::Ball:
+      return velocity ? std::vector<std::string>{".wx", ".wy", ".wz"}
+                      : std::vector<std::string>{".qx", ".qy", ".qz", ".qw"};
+  }
+  return {};
+}
+
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"') q += '"';
+    q += c;
+  }
+  return q + "\"";
+}
+
+}  // namespace
+
+std::vector<std::string> trajectoryColumns(const Model& model, const ConstraintList& constraints) {
+  std::vector<std::string> cols = {"time"};
+  for (const char* prefix : {"q:", "v:"})
+    for (int j = 0; j < model.nbodies; ++j)
+      for (const std::string& c : coordNames(model.joints[j].type, prefix[0] == 'v'))
+        cols.push_back(prefix + model.joint_names[j] + c);
+  cols.push_back("energy");
+  cols.push_back("residual");
+  for (const auto& con : constraints) {
+    for (const char* xyz : {".x", ".y", ".z"}) cols.push_back("point:" + con->name() + xyz);
+    for (const char* xyz : {".x", ".y", ".z"}) cols.push_back("normal:" + con->name() + xyz);
+    for (int k = 0; k < con->rows(); ++k)
+      cols.push_back("lambda:" + con->name() + "." + con->rowLabel(k));
+  }
+  return cols;
+}
+
+TrajectoryWriter::TrajectoryWriter(std::ostream& out, const Scene& scene)
+    : TrajectoryWriter(out, scene.model, scene.constraints) {}
+
+TrajectoryWriter::TrajectoryWriter(std::ostream& out, const Model& model,
+                                   const ConstraintList& constraints)
+    : out_(out),
+      nq_(model.nq),
+      nv_(model.nv),
+      nconstraints_(static_cast<int>(constraints.size())),
+      nrows_(0),
+      columns_(trajectoryColumns(model, constraints)) {
+  for (const auto& c : constraints) {
+    rows_.push_back(c->rows());
+    nrows_ += c->rows();
+  }
+  std::string header;
+  for (std::size_t k = 0; k < columns_.size(); ++k)
+    header += (k ? "," : "") + csvField(columns_[k]);
+  out_ << header << '\n';
+  line_.reserve(columns_.size() * 24);
+}
+
+void TrajectoryWriter::put(double x) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  if (!line_.empty()) line_ += ',';
+  line_.append(buf, r.ptr);
+}
+
+void TrajectoryWriter::write(double t, const VecX& q, const VecX& v, double energy,
+                             double residual, const std::vector<ContactFrame>& frames,
+                             const VecX& lambda) {
+  if (q.size() != nq_ || v.size() != nv_ || static_cast<int>(frames.size()) != nconstraints_ ||
+      lambda.size() != nrows_)
+    throw std::invalid_argument(
+        "TrajectoryWriter::write: sizes q " + std::to_string(q.size()) + "/" + std::to_string(nq_) +
+        ", v " + std::to_string(v.size()) + "/" + std::to_string(nv_) + ", frames " +
+        std::to_string(frames.size()) + "/" + std::to_string(nconstraints_) + ", lambda " +
+        std::to_string(lambda.size()) + "/" + std::to_string(nrows_) + " (given/expected)");
+  line_.clear();
+  put(t);
+  for (int i = 0; i < nq_; ++i) put(q(i));
+  for (int i = 0; i < nv_; ++i) put(v(i));
+  put(energy);
+  put(residual);
+  int row = 0;
+  for (int c = 0; c < nconstraints_; ++c) {
+    for (int k = 0; k < 3; ++k) put(frames[c].point(k));
+    for (int k = 0; k < 3; ++k) put(frames[c].normal(k));
+    for (int k = 0; k < rows_[c]; ++k) put(lambda(row++));
+  }
+  line_ += '\n';
+  out_ << line_;
+  ++samples_;
+}
+
+}  // namespace appell

@@ -1,0 +1,48 @@
+// Strict reading of XML attributes with messages that name the file, the
+// line and the element (TinyXML 1, the parser urdfdom itself uses on Debian).
+#pragma once
+
+#include <appell/scene.hpp>
+
+#include <tinyxml.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace appell::io {
+
+/// Where an element came from, for messages.
+struct XmlSource {
+  std::string file;
+};
+
+/// "<joint name=\"j1\">" — the tag with its name attribute, if any.
+std::string describe(const TiXmlElement* e);
+
+/// Throws SceneError "file:line: <element>: reason".
+[[noreturn]] void fail(const XmlSource& src, const TiXmlElement* e, const std::string& reason);
+/// Throws SceneError "file: reason".
+[[noreturn]] void fail(const XmlSource& src, const std::string& reason);
+
+/// Parses one finite double; nullopt if `text` is not exactly one number
+/// (surrounding spaces allowed). `finite` is false for nan/inf.
+std::optional<double> parseNumber(const std::string& text, bool* finite = nullptr);
+
+/// Attribute accessors. `what` names the attribute in messages.
+bool has(const TiXmlElement* e, const char* attr);
+std::string text(const XmlSource& src, const TiXmlElement* e, const char* attr);  ///< required
+std::string text(const TiXmlElement* e, const char* attr, const std::string& fallback);
+double number(const XmlSource& src, const TiXmlElement* e, const char* attr);      ///< required
+double number(const XmlSource& src, const TiXmlElement* e, const char* attr, double fallback);
+std::vector<double> numbers(const XmlSource& src, const TiXmlElement* e, const char* attr,
+                            int count = -1);  ///< required; count −1: any (≥ 1)
+Vec3 vec3(const XmlSource& src, const TiXmlElement* e, const char* attr);
+Vec3 vec3(const XmlSource& src, const TiXmlElement* e, const char* attr, const Vec3& fallback);
+
+/// `<origin xyz rpy>` child of `e` (identity if absent), as URDF defines it:
+/// R = Rz(yaw) Ry(pitch) Rx(roll).
+SE3 origin(const XmlSource& src, const TiXmlElement* e);
+Mat3 rpyToMatrix(const Vec3& rpy);
+
+}  // namespace appell::io
