@@ -1,0 +1,134 @@
+// The simulation loop: integrate the constrained dynamics, then remove the drift.
+//
+//   step(h):  (t, q, v) → integrator step on v̇ = solver(t, q, v, τ(t, q, v))
+//             → position projection (Newton on the holonomic gaps, M metric)
+//             → velocity projection (solver.projectVelocity, M metric)
+//             → reset the integrator's FSAL stage (the state was changed)
+//             → evaluate the end state for reports (λ, contact frames,
+//               energy, residuals).
+// A step that fails (solver error, non-finite joint forces or state, step size
+// below h_min, projection failure) returns a status with the reason and leaves
+// the last good state untouched. Everything is preallocated at construction:
+// step() performs no heap allocation on success (given constraints and a
+// joint-force callback that do not allocate).
+#pragma once
+
+#include <appell/constrained_dynamics.hpp>
+#include <appell/integrators.hpp>
+#include <appell/projection.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace appell {
+
+struct SimulatorOptions {
+  bool project_positions = true;   ///< Newton on the holonomic gaps after every step
+  bool project_velocities = true;  ///< impulse solve after every step
+  ProjectionOptions projection;
+  BaumgarteOptions baumgarte;      ///< off by default (projection is the method)
+  /// Solve the dynamics at the end of each step, so lambda() and contact
+  /// frames describe the current state (one extra solve per step).
+  bool evaluate_end_state = true;
+};
+
+struct StepStatus {
+  bool ok = true;
+  std::string message;   ///< why !ok (empty on success)
+  double h_taken = 0;
+  double h_next = 0;     ///< the integrator's suggestion (adaptive) or h
+  int rejected = 0;
+  int evaluations = 0;
+  int projection_iterations = 0;
+};
+
+struct SimulatorCounters {
+  long steps = 0;                  ///< accepted steps
+  long rejected = 0;               ///< rejected attempts (adaptive)
+  long evaluations = 0;            ///< dynamics solves by the integrator
+  long failed = 0;                 ///< step() calls that returned !ok
+  long projection_iterations = 0;  ///< Newton iterations of the position projection
+};
+
+class Simulator {
+ public:
+  /// τ(t, q, v) written into `tau` (size nv, zeroed before the call).
+  using JointForces = std::function<void(double t, const VecX& q, const VecX& v, VecX& tau)>;
+
+  /// `model` must outlive the simulator. The state starts at t = 0, the
+  /// neutral configuration and zero velocity; call setState().
+  Simulator(const Model& model, ConstraintList constraints,
+            std::unique_ptr<ConstrainedSolver> solver, IntegratorType integrator,
+            const IntegratorOptions& integrator_options = {},
+            const SimulatorOptions& options = {});
+  ~Simulator();
+
+  /// Sets the state (throws std::invalid_argument on wrong sizes or non-finite
+  /// values) and evaluates it for reports; does not project.
+  void setState(double t, const VecX& q, const VecX& v);
+  /// Projects the current state onto the constraints (e.g. initial conditions).
+  StepStatus projectState();
+  void setJointForces(JointForces tau);
+
+  /// One step of size h (the first attempt, for adaptive integrators).
+  StepStatus step(double h);
+  /// Steps until t_end: fixed-step integrators with steps of h (the last one
+  /// shortened), adaptive ones starting from h and then following their own
+  /// suggestion. Stops at the first failure and returns it.
+  StepStatus advanceTo(double t_end, double h);
+
+  // State.
+  double time() const { return t_; }
+  const VecX& q() const { return q_; }
+  const VecX& v() const { return v_; }
+
+  // Reports of the current state (after the last step / setState).
+  const ConstrainedResult& dynamics() const { return result_; }   ///< v̇, λ, Aᵀλ, rank
+  const VecX& lambda() const { return result_.lambda; }
+  const ContactFrame& contactFrame(int constraint) const;
+  const ConstraintData& constraintData() const { return *cdata_; }
+  double kineticEnergy() const { return kinetic_; }
+  double potentialEnergy() const { return potential_; }
+  double energy() const { return kinetic_ + potential_; }
+  double velocityResidual() const { return velocity_residual_; }  ///< ‖A v + b‖∞
+  double gapResidual() const { return gap_residual_; }            ///< max |g|
+  int redundantRows() const { return result_.redundant; }
+  /// Coordinate-partition re-choices of an AppellSolver (0 for other solvers).
+  int partitionChanges() const;
+  const PositionProjectionResult& lastProjection() const { return projection_; }
+  const VecX& lastImpulse() const { return impulse_; }
+  const SimulatorCounters& counters() const { return counters_; }
+
+  const Model& model() const { return model_; }
+  const ConstraintList& constraints() const { return constraints_; }
+  ConstrainedSolver& solver() { return *solver_; }
+  Integrator& integrator() { return *integrator_; }
+
+ private:
+  class Field;
+  StepStatus fail(StepStatus st, std::string message);
+  bool evaluateEndState(std::string& error);
+  void restore();
+
+  const Model& model_;
+  ConstraintList constraints_;
+  std::unique_ptr<ConstrainedSolver> solver_;
+  std::unique_ptr<Integrator> integrator_;
+  SimulatorOptions options_;
+  std::unique_ptr<Data> data_;
+  std::unique_ptr<ConstraintData> cdata_;
+  std::unique_ptr<PositionProjector> projector_;
+  std::unique_ptr<Field> field_;
+  JointForces tau_fn_;
+
+  double t_ = 0, t_prev_ = 0;
+  VecX q_, v_, q_prev_, v_prev_, tau_, impulse_;
+  ConstrainedResult result_;
+  PositionProjectionResult projection_;
+  double kinetic_ = 0, potential_ = 0, velocity_residual_ = 0, gap_residual_ = 0;
+  double h_suggest_ = 0;
+  SimulatorCounters counters_;
+};
+
+}  // namespace appell

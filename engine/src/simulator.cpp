@@ -1,0 +1,260 @@
+#include <appell/appell_maggi.hpp>
+#include <appell/configuration.hpp>
+#include <appell/dynamics.hpp>
+#include <appell/kkt.hpp>
+#include <appell/simulator.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace appell {
+
+// v̇ = f(t, q, v): joint forces, constraint rows, the solver. Failures are
+// remembered (with the reason) and reported as "not admissible" to the
+// integrator, which then rejects the step.
+class Simulator::Field final : public AccelerationField {
+ public:
+  explicit Field(Simulator& s) : s_(s), tau_(VecX::Zero(s.model_.nv)) {}
+
+  bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) override {
+    Simulator& s = s_;
+    tau_.setZero();
+    if (s.tau_fn_) {
+      s.tau_fn_(t, q, v, tau_);
+      if (tau_.size() != s.model_.nv || !tau_.allFinite()) {
+        record("the joint-force callback returned a non-finite or wrongly sized tau", t);
+        return false;
+      }
+    }
+    evaluateConstraints(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
+    if (s.options_.baumgarte.enabled)
+      applyBaumgarte(*s.cdata_, v, s.options_.baumgarte.alpha, s.options_.baumgarte.beta);
+    s.solver_->solve(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, tau_, stage_);
+    if (!stage_.ok) {
+      record(stage_.error, t);
+      return false;
+    }
+    if (!stage_.vdot.allFinite()) {
+      record("the solver returned a non-finite acceleration", t);
+      return false;
+    }
+    vdot = stage_.vdot;
+    return true;
+  }
+
+  void clear() {
+    failed_ = false;
+    message_.clear();
+  }
+  bool failed() const { return failed_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  void record(const std::string& why, double t) {
+    if (failed_) return;  // keep the first reason
+    failed_ = true;
+    std::ostringstream os;
+    os << why << " (at t = " << t << ")";
+    message_ = os.str();
+  }
+
+  Simulator& s_;
+  VecX tau_;
+  ConstrainedResult stage_;
+  bool failed_ = false;
+  std::string message_;
+};
+
+Simulator::Simulator(const Model& model, ConstraintList constraints,
+                     std::unique_ptr<ConstrainedSolver> solver, IntegratorType integrator,
+                     const IntegratorOptions& integrator_options, const SimulatorOptions& options)
+    : model_(model), constraints_(std::move(constraints)), solver_(std::move(solver)),
+      integrator_(makeIntegrator(integrator, model, integrator_options)), options_(options) {
+  if (!solver_) throw std::invalid_argument("Simulator: no constrained solver given");
+  for (const auto& c : constraints_)
+    if (!c) throw std::invalid_argument("Simulator: the constraint list holds a null constraint");
+  data_ = std::make_unique<Data>(model_);
+  cdata_ = std::make_unique<ConstraintData>(model_, constraints_);
+  projector_ = std::make_unique<PositionProjector>(model_, constraints_, options_.projection);
+  field_ = std::make_unique<Field>(*this);
+  q_ = neutralConfiguration(model_);
+  v_ = VecX::Zero(model_.nv);
+  q_prev_ = q_;
+  v_prev_ = v_;
+  tau_ = VecX::Zero(model_.nv);
+  impulse_ = VecX::Zero(cdata_->m);
+  result_.vdot = VecX::Zero(model_.nv);
+  result_.lambda = VecX::Zero(cdata_->m);
+  result_.reaction = VecX::Zero(model_.nv);
+  // Size every per-step buffer of the field and the solver once, here.
+  std::string ignored;
+  evaluateEndState(ignored);
+  VecX vdot(model_.nv);
+  (*field_)(t_, q_, v_, vdot);
+  field_->clear();
+}
+
+Simulator::~Simulator() = default;
+
+void Simulator::setState(double t, const VecX& q, const VecX& v) {
+  if (q.size() != model_.nq || v.size() != model_.nv)
+    throw std::invalid_argument("Simulator::setState: q must have size nq = " +
+                                std::to_string(model_.nq) + " and v size nv = " +
+                                std::to_string(model_.nv));
+  if (!std::isfinite(t) || !q.allFinite() || !v.allFinite())
+    throw std::invalid_argument("Simulator::setState: non-finite time, q or v");
+  t_ = t;
+  q_ = q;
+  v_ = v;
+  integrator_->reset();
+  h_suggest_ = 0;
+  std::string error;
+  evaluateEndState(error);
+}
+
+void Simulator::setJointForces(JointForces tau) { tau_fn_ = std::move(tau); }
+
+int Simulator::partitionChanges() const {
+  if (auto* a = dynamic_cast<const AppellSolver*>(solver_.get())) return a->partitionChanges();
+  return 0;
+}
+
+const ContactFrame& Simulator::contactFrame(int constraint) const {
+  if (constraint < 0 || constraint >= static_cast<int>(cdata_->blocks.size()))
+    throw std::out_of_range("Simulator::contactFrame: no constraint " +
+                            std::to_string(constraint));
+  return cdata_->blocks[constraint].frame;
+}
+
+void Simulator::restore() {
+  t_ = t_prev_;
+  q_ = q_prev_;
+  v_ = v_prev_;
+  integrator_->reset();
+  std::string ignored;
+  evaluateEndState(ignored);
+}
+
+StepStatus Simulator::fail(StepStatus st, std::string message) {
+  restore();
+  st.ok = false;
+  st.message = std::move(message);
+  ++counters_.failed;
+  return st;
+}
+
+// Reports of the current state: constraint rows, residuals, energy and, when
+// asked, the dynamics (λ, contact forces) at (t, q, v).
+bool Simulator::evaluateEndState(std::string& error) {
+  evaluateConstraints(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  velocity_residual_ = appell::velocityResidual(*cdata_, v_);
+  gap_residual_ = appell::gapResidual(*cdata_);
+  bool ok = true;
+  if (options_.evaluate_end_state) {
+    tau_.setZero();
+    if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
+    if (tau_.size() == model_.nv && tau_.allFinite()) {
+      solver_->solve(model_, *data_, constraints_, *cdata_, q_, v_, tau_, result_);
+      if (!result_.ok) {
+        error = result_.error;
+        ok = false;
+      }
+    } else {
+      error = "the joint-force callback returned a non-finite or wrongly sized tau";
+      ok = false;
+    }
+  }
+  kinetic_ = appell::kineticEnergy(model_, *data_, q_, v_);
+  potential_ = appell::potentialEnergy(model_, *data_, q_);
+  return ok;
+}
+
+StepStatus Simulator::projectState() {
+  StepStatus st;
+  t_prev_ = t_;
+  q_prev_ = q_;
+  v_prev_ = v_;
+  const StateProjectionResult pr = appell::projectState(
+      model_, *data_, constraints_, *cdata_, *solver_, *projector_, t_, q_, v_, impulse_);
+  projection_ = pr.position;
+  st.projection_iterations = pr.position.iterations;
+  if (!pr.ok) return fail(st, pr.error);
+  integrator_->reset();
+  std::string error;
+  if (!evaluateEndState(error)) return fail(st, error);
+  return st;
+}
+
+StepStatus Simulator::step(double h) {
+  StepStatus st;
+  if (!(h > 0) || !std::isfinite(h)) {
+    std::ostringstream os;
+    os << "Simulator::step: the step size must be positive and finite (got " << h << ")";
+    throw std::invalid_argument(os.str());
+  }
+  t_prev_ = t_;
+  q_prev_ = q_;
+  v_prev_ = v_;
+  field_->clear();
+  const StepResult r = integrator_->step(*field_, t_, q_, v_, h);
+  st.h_taken = r.h_taken;
+  st.h_next = r.h_next;
+  st.rejected = r.rejected;
+  st.evaluations = r.evaluations;
+  counters_.rejected += r.rejected;
+  counters_.evaluations += r.evaluations;
+  if (!r.ok) {
+    if (field_->failed()) return fail(st, field_->message());
+    return fail(st, integrator_->adaptive()
+                        ? "the step size fell below h_min (the dynamics are too stiff or singular here)"
+                        : "the integrator produced a non-finite state");
+  }
+  if (!std::isfinite(t_) || !q_.allFinite() || !v_.allFinite())
+    return fail(st, "the integrator produced a non-finite state");
+
+  // Drift control: positions onto the gaps, then velocities onto A v + b = 0.
+  if (options_.project_positions) {
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
+    st.projection_iterations = projection_.iterations;
+    counters_.projection_iterations += projection_.iterations;
+    if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
+  }
+  if (options_.project_velocities && cdata_->m > 0) {
+    if (!options_.project_positions)
+      evaluateConstraints(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
+      std::string why = "velocity projection failed";
+      if (auto* k = dynamic_cast<const KktSolver*>(solver_.get())) why += ": " + k->lastError();
+      if (auto* a = dynamic_cast<const AppellSolver*>(solver_.get())) why += ": " + a->lastError();
+      return fail(st, why);
+    }
+  }
+  if (options_.project_positions || options_.project_velocities) integrator_->reset();
+
+  std::string error;
+  if (!evaluateEndState(error)) return fail(st, error);
+  ++counters_.steps;
+  return st;
+}
+
+StepStatus Simulator::advanceTo(double t_end, double h) {
+  if (!(h > 0) || !std::isfinite(h) || !std::isfinite(t_end))
+    throw std::invalid_argument("Simulator::advanceTo: h must be positive and t_end finite");
+  StepStatus st;
+  const double eps = 1e-12 * std::max(1.0, std::abs(t_end));
+  const bool adaptive = integrator_->adaptive();
+  if (adaptive && h_suggest_ <= 0) h_suggest_ = h;
+  while (t_end - t_ > eps) {
+    const double remaining = t_end - t_;
+    const double want = adaptive ? h_suggest_ : h;
+    const bool last = want >= remaining;
+    st = step(last ? remaining : want);
+    if (!st.ok) return st;
+    // A step shortened to land on t_end says nothing about the next one.
+    if (adaptive && (!last || st.h_taken < remaining)) h_suggest_ = st.h_next;
+  }
+  return st;
+}
+
+}  // namespace appell
