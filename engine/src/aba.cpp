@@ -29,7 +29,10 @@ const VecX& aba(const Model& model, Data& data, const VecX& q, const VecX& v, co
       const MatD D = j.S.transpose() * data.U[i];
       const MatD Dinv = D.llt().solve(MatD::Identity(j.nv, j.nv));
       data.Dinv[i].topLeftCorner(j.nv, j.nv) = Dinv;
-      data.u[i].head(j.nv) = tau.segment(j.idx_v, j.nv) - j.S.transpose() * data.pA[i];
+      // Two statements on purpose: Eigen evaluates `segment − Sᵀ p` (a
+      // dynamic-size segment minus a max-6 product) through a heap temporary.
+      data.u[i].head(j.nv) = tau.segment(j.idx_v, j.nv);
+      data.u[i].head(j.nv).noalias() -= j.S.transpose() * data.pA[i];
       Ia.noalias() -= data.U[i] * Dinv * data.U[i].transpose();
       pa.noalias() += data.U[i] * (Dinv * data.u[i].head(j.nv));
     }
