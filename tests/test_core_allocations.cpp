@@ -1,0 +1,213 @@
+// No heap allocation inside the per-step algorithms.
+//
+// Every allocation in this executable is counted: the global operator new /
+// delete are replaced, and so are malloc/calloc/realloc/aligned allocation —
+// Eigen's dynamic matrices allocate through malloc, not through operator new,
+// so counting only `new` would miss exactly the allocations that matter.
+// (The replacements forward to glibc's __libc_* entry points.) Each algorithm
+// is warmed up once (Data and the integrators are sized at construction), then
+// called repeatedly while counting; the count must be zero. A positive control
+// shows the counter sees both kinds of allocation.
+#include "random_tree.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+extern "C" {
+void* __libc_malloc(size_t);
+void* __libc_calloc(size_t, size_t);
+void* __libc_realloc(void*, size_t);
+void* __libc_memalign(size_t, size_t);
+void __libc_free(void*);
+}
+
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+inline void note() {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+}
+}  // namespace
+
+extern "C" {
+void* malloc(size_t n) {
+  note();
+  return __libc_malloc(n);
+}
+void* calloc(size_t n, size_t s) {
+  note();
+  return __libc_calloc(n, s);
+}
+void* realloc(void* p, size_t n) {
+  note();
+  return __libc_realloc(p, n);
+}
+void free(void* p) { __libc_free(p); }
+void* aligned_alloc(size_t align, size_t n) {
+  note();
+  return __libc_memalign(align, n);
+}
+void* memalign(size_t align, size_t n) {
+  note();
+  return __libc_memalign(align, n);
+}
+int posix_memalign(void** out, size_t align, size_t n) {
+  note();
+  *out = __libc_memalign(align, n);
+  return *out ? 0 : ENOMEM;
+}
+}
+
+void* operator new(size_t n) {
+  note();
+  if (void* p = __libc_malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](size_t n) { return operator new(n); }
+void* operator new(size_t n, std::align_val_t a) {
+  note();
+  if (void* p = __libc_memalign(static_cast<size_t>(a), n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](size_t n, std::align_val_t a) { return operator new(n, a); }
+void operator delete(void* p) noexcept { __libc_free(p); }
+void operator delete[](void* p) noexcept { __libc_free(p); }
+void operator delete(void* p, size_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, size_t) noexcept { __libc_free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { __libc_free(p); }
+void operator delete(void* p, size_t, std::align_val_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, size_t, std::align_val_t) noexcept { __libc_free(p); }
+
+using namespace appell;
+
+namespace {
+
+/// Allocations made by `fn` over `reps` calls, after one warm-up call.
+template <typename F>
+long allocationsIn(F&& fn, int reps = 20) {
+  fn();
+  g_allocations = 0;
+  g_counting = true;
+  for (int r = 0; r < reps; ++r) fn();
+  g_counting = false;
+  return g_allocations.load();
+}
+
+struct AbaField : AccelerationField {
+  const Model& model;
+  Data& data;
+  const VecX& tau;
+  AbaField(const Model& m, Data& d, const VecX& t) : model(m), data(d), tau(t) {}
+  bool operator()(double, const VecX& q, const VecX& v, VecX& a) override {
+    a = aba(model, data, q, v, tau);
+    return true;
+  }
+};
+
+class Allocations : public ::testing::TestWithParam<bool> {
+ protected:
+  void SetUp() override {
+    std::mt19937 rng(GetParam() ? 5 : 6);
+    model = test::randomTree(40, GetParam(), rng);
+    data = std::make_unique<Data>(model);
+    q = randomConfiguration(model, rng);
+    v = test::randomVector(model.nv, rng);
+    a = test::randomVector(model.nv, rng);
+    tau = test::randomVector(model.nv, rng);
+    fext.assign(model.nbodies, Vec6::Ones());
+    J.resize(6, model.nv);
+    theta = test::randomVector(model.nv, rng, 0.3);
+    out_q.resize(model.nq);
+    out_v.resize(model.nv);
+  }
+  Model model;
+  std::unique_ptr<Data> data;
+  VecX q, v, a, tau, theta, out_q, out_v;
+  BodyForces fext;
+  MatX J;
+};
+
+}  // namespace
+
+TEST(AllocationCounter, SeesMallocAndNew) {
+  const long n = allocationsIn([] {
+    VecX x(1000);                      // Eigen: malloc
+    auto p = std::make_unique<int>(3);  // operator new
+    x.setConstant(*p);
+    EXPECT_EQ(x.sum(), 3000.0);
+  }, 5);
+  EXPECT_EQ(n, 10);
+}
+
+TEST_P(Allocations, KinematicsDoNotAllocate) {
+  Data& d = *data;
+  EXPECT_EQ(allocationsIn([&] { forwardKinematics(model, d, q); }), 0);
+  EXPECT_EQ(allocationsIn([&] { forwardKinematics(model, d, q, v); }), 0);
+  EXPECT_EQ(allocationsIn([&] { forwardKinematics(model, d, q, v, a); }), 0);
+  const int body = model.nbodies - 1;
+  const Vec3 r(0.1, 0.2, 0.3);
+  EXPECT_EQ(allocationsIn([&] { pointJacobian(model, d, body, r, J); }), 0);
+  EXPECT_EQ(allocationsIn([&] { spatialJacobianWorld(model, d, body, J); }), 0);
+  Vec6 sink = Vec6::Zero();
+  EXPECT_EQ(allocationsIn([&] {
+              sink += pointJacobianDotTimesV(d, body, r) + pointAcceleration(d, body, r) +
+                      pointVelocity(d, body, r) + spatialVelocityWorld(d, body) +
+                      spatialAccelerationWorld(d, body);
+            }),
+            0);
+  EXPECT_TRUE(sink.allFinite());
+}
+
+TEST_P(Allocations, DynamicsDoNotAllocate) {
+  Data& d = *data;
+  EXPECT_EQ(allocationsIn([&] { rnea(model, d, q, v, a); }), 0);
+  EXPECT_EQ(allocationsIn([&] { rnea(model, d, q, v, a, &fext); }), 0);
+  EXPECT_EQ(allocationsIn([&] { nonLinearEffects(model, d, q, v); }), 0);
+  EXPECT_EQ(allocationsIn([&] { crba(model, d, q); }), 0);
+  EXPECT_EQ(allocationsIn([&] { aba(model, d, q, v, tau); }), 0);
+  EXPECT_EQ(allocationsIn([&] { aba(model, d, q, v, tau, &fext); }), 0);
+  double e = 0;
+  EXPECT_EQ(allocationsIn([&] {
+              e += kineticEnergy(model, d, q, v) + potentialEnergy(model, d, q) +
+                   momentum(model, d, q, v).norm();
+            }),
+            0);
+  EXPECT_TRUE(std::isfinite(e));
+}
+
+TEST_P(Allocations, ConfigurationManifoldDoesNotAllocate) {
+  EXPECT_EQ(allocationsIn([&] { retract(model, q, theta, out_q); }), 0);
+  EXPECT_EQ(allocationsIn([&] { localRate(model, q, theta, v, out_v); }), 0);
+  EXPECT_EQ(allocationsIn([&] { difference(model, q, out_q, out_v); }), 0);
+  EXPECT_EQ(allocationsIn([&] { configurationRate(model, q, v, out_q); }), 0);
+}
+
+TEST_P(Allocations, IntegratorStepsDoNotAllocate) {
+  for (IntegratorType type : {IntegratorType::SymplecticEuler, IntegratorType::RK4,
+                              IntegratorType::DormandPrince54}) {
+    Data& d = *data;
+    AbaField field(model, d, tau);
+    auto integ = makeIntegrator(type, model);
+    VecX qs = q, vs = v;
+    double t = 0;
+    double h = 1e-3;
+    const long n = allocationsIn([&] {
+      for (int k = 0; k < 2; ++k) {  // the second step reuses the FSAL stage
+        const StepResult r = integ->step(field, t, qs, vs, h);
+        ASSERT_TRUE(r.ok);
+        if (integ->adaptive()) h = r.h_next;
+      }
+      integ->reset();  // and the next call takes the non-FSAL path
+    });
+    EXPECT_EQ(n, 0) << toString(type);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Bases, Allocations, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& p) {
+                           return std::string(p.param ? "floating" : "fixed");
+                         });
