@@ -1,0 +1,199 @@
+// The <appell> scene block: supports and their motion, contacts and their
+// shapes (from collision geometry or explicit), initial state, efforts,
+// settings — and the initial-state check with its projection.
+#include <appell/dynamics.hpp>
+#include <appell/kinematics.hpp>
+#include <appell/urdf.hpp>
+
+#include <gtest/gtest.h>
+
+using namespace appell;
+
+namespace {
+
+const std::string kData = std::string(APPELL_SOURCE_DIR) + "/tests/data/io/";
+
+template <class T>
+const T& as(const Shape& s) {
+  EXPECT_TRUE(std::holds_alternative<T>(s)) << "shape is " << shapeName(s);
+  return std::get<T>(s);
+}
+
+}  // namespace
+
+TEST(IoScene, BallOnTurntable) {
+  const Scene s = loadScene(kData + "scenes/ball_turntable.urdf");
+  EXPECT_EQ(s.source, kData + "scenes/ball_turntable.urdf");
+  ASSERT_EQ(s.model.nbodies, 1);
+  EXPECT_EQ(s.model.joints[0].type, JointType::Floating);
+  EXPECT_TRUE(s.model.gravity.isApprox(Vec3(0, 0, -9.81)));
+
+  ASSERT_EQ(s.supports.size(), 1u);
+  EXPECT_EQ(s.supports[0].name, "table");
+  const auto& plane = std::get<Plane>(s.supports[0].surface);
+  EXPECT_TRUE(plane.normal.isApprox(Vec3::UnitZ()));
+  ASSERT_TRUE(isMoving(s.supports[0].motion));
+  // The table's material velocity at (0.5, 0, 0) is Ω × r = (0, 1, 0).
+  const SupportState st = supportState(s.supports[0].motion, 0.0);
+  EXPECT_TRUE(st.pointVelocity(Vec3(0.5, 0, 0)).isApprox(Vec3(0, 1, 0), 1e-15));
+
+  ASSERT_EQ(s.contacts.size(), 1u);
+  ASSERT_EQ(s.constraints.size(), 1u);
+  const ContactInfo& c = s.contacts[0];
+  EXPECT_EQ(c.name, "ball_table");
+  EXPECT_EQ(c.link, "ball");
+  EXPECT_EQ(c.body, 0);
+  EXPECT_EQ(c.kind, ContactKind::Rolling);
+  EXPECT_EQ(c.support_index, 0);
+  EXPECT_DOUBLE_EQ(c.mu, 0.6);
+  EXPECT_EQ(c.shape_source, "collision[0] (sphere)");
+  EXPECT_DOUBLE_EQ(as<Sphere>(c.shape).radius, 0.1);
+  EXPECT_EQ(s.constraints[0]->name(), "ball_table");
+  EXPECT_EQ(s.constraints[0]->rows(), 3);
+  EXPECT_EQ(s.constraintRows(), 3);
+  EXPECT_EQ(s.contactIndex("ball_table"), 0);
+  EXPECT_EQ(s.contactIndex("nope"), -1);
+
+  // Initial state as declared, and it satisfies the moving constraint.
+  ASSERT_EQ(s.q0.size(), 7);
+  EXPECT_TRUE(s.q0.head<3>().isApprox(Vec3(0.5, 0, 0.1)));
+  EXPECT_NEAR(s.q0(6), 1.0, 1e-15);
+  EXPECT_TRUE(s.v0.isApprox((VecX(6) << 0, 0, 0, 0, 1, 0).finished()));
+  Scene copy = s;
+  const InitialStateReport r = checkInitialState(copy, false);
+  EXPECT_LT(r.velocity_residual, 1e-14);
+  EXPECT_LT(r.gap_residual, 1e-14);
+  EXPECT_FALSE(r.projected);
+
+  EXPECT_EQ(s.settings.integrator, "dopri5");
+  EXPECT_DOUBLE_EQ(s.settings.dt, 0.01);
+  EXPECT_DOUBLE_EQ(s.settings.tol, 1e-9);
+  EXPECT_DOUBLE_EQ(s.settings.duration, 12.5);
+  EXPECT_EQ(s.settings.formulation, "kkt");
+  EXPECT_TRUE(s.tau.isZero());
+}
+
+TEST(IoScene, SleighKnifeEdgeAndSlidingFeet) {
+  const Scene s = loadScene(kData + "scenes/sleigh.urdf");
+  ASSERT_EQ(s.contacts.size(), 3u);
+  EXPECT_EQ(s.contacts[0].kind, ContactKind::KnifeEdge);
+  EXPECT_EQ(s.contacts[0].shape_source, "explicit");
+  EXPECT_TRUE(as<PointShape>(s.contacts[0].shape).position.isZero());
+  EXPECT_TRUE(s.contacts[0].blade_direction.isApprox(Vec3(2, 0, 0)));
+  EXPECT_EQ(s.constraints[0]->rows(), 2);
+  EXPECT_EQ(s.constraints[0]->rowLabel(0), "lateral");
+  EXPECT_EQ(s.contacts[1].kind, ContactKind::Sliding);
+  EXPECT_TRUE(as<PointShape>(s.contacts[1].shape).position.isApprox(Vec3(0.6, 0.2, 0)));
+  EXPECT_EQ(s.constraints[1]->rows(), 1);
+  EXPECT_EQ(s.constraintRows(), 4);
+  EXPECT_TRUE(std::isinf(s.contacts[1].mu));
+  // The tilted initial orientation puts all three points on the slope.
+  Scene copy = s;
+  EXPECT_LT(checkInitialState(copy, false).gap_residual, 1e-14);
+  // Efforts: generalized forces on the floating base (body-frame torque z 0.5).
+  ASSERT_EQ(s.tau.size(), 6);
+  EXPECT_TRUE(s.tau.isApprox((VecX(6) << 0, 0, 0.5, 0, 0, 0).finished()));
+  EXPECT_EQ(s.settings.integrator, "rk4");
+  EXPECT_EQ(s.settings.formulation, "tree");  // the default
+}
+
+TEST(IoScene, ShapesFromCollisionGeometryAndExplicit) {
+  LoadOptions opt;
+  opt.check_initial_state = false;  // the shapes are what matters here
+  const Scene s = loadScene(kData + "scenes/shapes.urdf", opt);
+  ASSERT_EQ(s.model.nbodies, 2);
+  EXPECT_EQ(s.model.parent[1], -1);  // two floating bodies under the world
+  ASSERT_EQ(s.contacts.size(), 7u);
+
+  // Plane given by a point and an unnormalised normal; conveyor motion.
+  const auto& ground = std::get<Plane>(s.supports[0].surface);
+  EXPECT_TRUE(ground.normal.isApprox(Vec3::UnitZ()));
+  EXPECT_TRUE(ground.point.isApprox(Vec3(0, 0, -1)));
+  EXPECT_TRUE(supportState(s.supports[0].motion, 1.0).V.tail<3>().isApprox(Vec3(0.5, 0, 0)));
+  const auto& bowl = std::get<SphereSurface>(s.supports[1].surface);
+  EXPECT_EQ(bowl.side, SphereSurface::Side::Inside);
+  EXPECT_DOUBLE_EQ(bowl.radius, 2);
+  const auto& globe = std::get<SphereSurface>(s.supports[2].surface);
+  EXPECT_EQ(globe.side, SphereSurface::Side::Outside);
+  const auto& tilt = std::get<SinusoidalTiltMotion>(s.supports[2].motion);
+  EXPECT_DOUBLE_EQ(tilt.amplitude, 0.1);
+  EXPECT_DOUBLE_EQ(tilt.frequency, 3);
+  EXPECT_DOUBLE_EQ(tilt.phase, 0.5);
+  EXPECT_TRUE(std::get<ConstantTwistMotion>(s.supports[3].motion).twist.head<3>().isApprox(Vec3::UnitZ()));
+
+  // A cylinder collision is a disk rim in its mid-plane, axle along its z.
+  const Disk& rim = as<Disk>(s.contacts[0].shape);
+  EXPECT_EQ(s.contacts[0].shape_source, "collision[0] (cylinder 'tread')");
+  EXPECT_DOUBLE_EQ(rim.radius, 0.3);
+  EXPECT_TRUE(rim.centre.isApprox(Vec3(0, 0.01, 0)));
+  EXPECT_TRUE(rim.axis.isApprox(Vec3(0, -1, 0), 1e-15));
+  EXPECT_EQ(s.contacts[0].kind, ContactKind::RollingWithoutSpin);
+  EXPECT_EQ(s.constraints[0]->rows(), 4);
+  // … or a torus with the same outer radius when a tyre radius is given.
+  const Torus& tyre = as<Torus>(s.contacts[1].shape);
+  EXPECT_DOUBLE_EQ(tyre.minor, 0.04);
+  EXPECT_NEAR(tyre.major + tyre.minor, 0.3, 1e-15);
+  // Selected by index.
+  EXPECT_DOUBLE_EQ(as<Sphere>(s.contacts[2].shape).radius, 0.05);
+  EXPECT_EQ(s.contacts[2].support, "bowl");
+  // Explicit ellipsoid with orientation.
+  const Ellipsoid& egg = as<Ellipsoid>(s.contacts[3].shape);
+  EXPECT_TRUE(egg.semi_axes.isApprox(Vec3(0.1, 0.2, 0.3)));
+  EXPECT_TRUE(egg.centre.isApprox(Vec3(0, 0, 0.01)));
+  EXPECT_TRUE((egg.orientation * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-15));
+  EXPECT_EQ(s.contacts[3].body, 1);
+  // Hemisphere: cap on the −z side by default.
+  const SphericalCap& cap = as<SphericalCap>(s.contacts[4].shape);
+  EXPECT_DOUBLE_EQ(cap.radius, 0.2);
+  EXPECT_NEAR(cap.half_angle, M_PI / 2, 1e-15);
+  EXPECT_TRUE(cap.axis.isApprox(-Vec3::UnitZ()));
+  // Explicit torus: radius is the outer radius.
+  const Torus& t = as<Torus>(s.contacts[5].shape);
+  EXPECT_NEAR(t.major, 0.2, 1e-15);
+  EXPECT_DOUBLE_EQ(t.minor, 0.1);
+  EXPECT_TRUE(t.axis.isApprox(Vec3::UnitY()));
+  // A knife edge on a disk takes its blade from the wheel plane.
+  EXPECT_EQ(s.contacts[6].kind, ContactKind::KnifeEdge);
+  EXPECT_EQ(s.constraints[6]->rows(), 2);
+}
+
+TEST(IoScene, ProjectionOfASlidingBallGivesFiveSevenths) {
+  // The ball starts 0.4 m above the plane, sliding at 1 m/s without spin.
+  // Projection puts it on the plane and, in the mass metric, onto rolling:
+  // min m|v − v₀|² + I ω² subject to v = r ω gives v = v₀ m r² /(m r² + I)
+  // = 5/7 for a homogeneous ball — the classic result (the impulse at the
+  // contact conserves angular momentum about the contact point).
+  LoadOptions opt;
+  opt.project_initial_state = true;
+  const Scene s = loadScene(kData + "bad/initial_violation.urdf", opt);
+  EXPECT_NEAR(s.q0(2), 0.1, 1e-12);
+  EXPECT_TRUE(s.q0.head<2>().isZero(1e-12));
+  EXPECT_NEAR(s.q0.tail<4>().head<3>().norm(), 0.0, 1e-12);  // orientation unchanged
+  EXPECT_NEAR(s.v0(3), 5.0 / 7.0, 1e-12);  // v_x (body frame)
+  EXPECT_NEAR(s.v0(1), 5.0 / 7.0 / 0.1, 1e-10);              // ω_y = v_x / r
+  EXPECT_NEAR(s.v0(0), 0, 1e-12);
+  EXPECT_NEAR(s.v0(2), 0, 1e-12);
+  EXPECT_NEAR(s.v0(5), 0, 1e-12);
+
+  Scene again = s;
+  const InitialStateReport r = checkInitialState(again, false);
+  EXPECT_LT(r.velocity_residual, 1e-12);
+  EXPECT_LT(r.gap_residual, 1e-12);
+}
+
+TEST(IoScene, LoadFromStringResolvesAgainstBaseDir) {
+  const std::string xml = R"(<robot name="s">
+    <link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+      <visual><geometry><mesh filename="meshes/cube.obj"/></geometry></visual></link>
+    <appell><gravity xyz="0 0 -1.62"/></appell></robot>)";
+  const Scene s = loadSceneFromString(xml, kData, "moon");
+  EXPECT_EQ(s.source, "moon");
+  EXPECT_TRUE(s.model.gravity.isApprox(Vec3(0, 0, -1.62)));
+  EXPECT_EQ(s.geometry[0].visual[0].mesh->triangles.size(), 12u);
+  try {
+    loadSceneFromString(xml, "/nonexistent", "moon");
+    ADD_FAILURE() << "mesh found in the wrong folder";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("moon:3: <mesh>:", 0), 0u) << e.what();
+  }
+}
