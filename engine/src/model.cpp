@@ -117,6 +117,14 @@ Model ModelBuilder::build() const {
   m.gravity = gravity_;
   if (!gravity_.allFinite()) throw ModelError("gravity is not finite");
   m.children.resize(n);
+  // Every body's own numbers first: the subtree masses below would otherwise
+  // turn one body's negative or NaN mass into a misleading error about another
+  // body (a parent whose subtree "carries no mass").
+  for (const Entry& e : entries_) {
+    if (!std::isfinite(e.inertia.mass) || !finite(e.inertia.com) || !finite(e.inertia.inertia_com))
+      fail(e.name, "inertia has a non-finite value");
+    if (e.inertia.mass < 0) fail(e.name, "negative mass " + std::to_string(e.inertia.mass));
+  }
   // Subtree mass decides whether a massless body is acceptable: a moving joint
   // needs something with inertia beyond it.
   std::vector<double> subtree_mass(n, 0.0);
