@@ -1,0 +1,176 @@
+// Bad model input is rejected by ModelBuilder::build() with a ModelError that
+// names the body and the reason — never a crash, never a model that silently
+// computes nonsense. Each case also has its valid neighbour, so a check that
+// rejects everything would fail here too.
+#include <appell/appell.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+
+using namespace appell;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+const double kInf = std::numeric_limits<double>::infinity();
+
+Inertia good() { return {1.0, Vec3(0.1, 0, 0), Vec3(0.2, 0.3, 0.4).asDiagonal()}; }
+
+/// A two-body model: "base" (revolute from the world) and "arm", where `edit`
+/// may spoil the arm's entry before it is added.
+struct ArmSpec {
+  int parent = 0;
+  SE3 placement = SE3::Identity();
+  JointType type = JointType::Revolute;
+  Vec3 axis = Vec3::UnitZ();
+  Inertia inertia = good();
+};
+
+Model build(const std::function<void(ArmSpec&)>& edit) {
+  ModelBuilder b;
+  b.addBody("base", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good());
+  ArmSpec s;
+  edit(s);
+  b.addBody("arm", s.parent, s.placement, s.type, s.axis, s.inertia);
+  return b.build();
+}
+
+/// Builds, expects a ModelError whose message contains every fragment.
+void expectError(const std::function<void(ArmSpec&)>& edit,
+                 const std::vector<std::string>& fragments) {
+  try {
+    build(edit);
+    ADD_FAILURE() << "no error; expected one mentioning '" << fragments.back() << "'";
+  } catch (const ModelError& e) {
+    const std::string msg = e.what();
+    for (const auto& f : fragments)
+      EXPECT_NE(msg.find(f), std::string::npos) << "message '" << msg << "' lacks '" << f << "'";
+  }
+}
+
+}  // namespace
+
+TEST(CoreErrors, ValidModelBuilds) {
+  EXPECT_NO_THROW(build([](ArmSpec&) {}));
+  // Massless bodies are fine where they cannot make the dynamics singular: a
+  // fixed attachment (sensor frame), or a moving link that carries mass.
+  ModelBuilder b;
+  const int base = b.addBody("base", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good());
+  b.addBody("sensor", base, SE3::Identity(), JointType::Fixed, Vec3::UnitZ(), Inertia{});
+  const int link = b.addBody("massless_link", base, SE3::Identity(), JointType::Revolute,
+                             Vec3::UnitY(), Inertia{});
+  SE3 X;
+  X.p = Vec3(0, 0, 0.5);
+  b.addBody("payload", link, X, JointType::Revolute, Vec3::UnitY(), good());
+  EXPECT_NO_THROW(b.build());
+  // A flat disk sits exactly on the triangle inequality (I₁ + I₂ = I₃).
+  EXPECT_NO_THROW(build([](ArmSpec& s) { s.inertia.inertia_com = Vec3(1, 1, 2).asDiagonal(); }));
+}
+
+TEST(CoreErrors, NegativeMass) {
+  expectError([](ArmSpec& s) { s.inertia.mass = -1.0; }, {"'arm'", "negative mass"});
+}
+
+TEST(CoreErrors, ZeroMassOnAMovingLeaf) {
+  expectError([](ArmSpec& s) { s.inertia = Inertia{}; }, {"'arm'", "zero mass"});
+  // … also when the leaf is reached through a massless fixed child.
+  ModelBuilder b;
+  b.addBody("base", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good());
+  b.addBody("hand", 0, SE3::Identity(), JointType::Prismatic, Vec3::UnitX(), Inertia{});
+  b.addBody("tip", 1, SE3::Identity(), JointType::Fixed, Vec3::UnitX(), Inertia{});
+  try {
+    b.build();
+    ADD_FAILURE() << "massless moving subtree accepted";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("'hand'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CoreErrors, ZeroMassWithRotationalInertia) {
+  expectError([](ArmSpec& s) { s.inertia.mass = 0; s.type = JointType::Fixed; },
+              {"'arm'", "zero mass but non-zero rotational inertia"});
+}
+
+TEST(CoreErrors, InertiaNotPositiveDefinite) {
+  expectError([](ArmSpec& s) { s.inertia.inertia_com = Vec3(0.2, -0.3, 0.4).asDiagonal(); },
+              {"'arm'", "not positive definite"});
+  expectError([](ArmSpec& s) { s.inertia.inertia_com = Vec3(0.2, 0.0, 0.2).asDiagonal(); },
+              {"'arm'", "not positive definite"});
+}
+
+TEST(CoreErrors, TriangleInequality) {
+  // Rotated, so the check must work on principal moments, not the diagonal.
+  expectError(
+      [](ArmSpec& s) {
+        const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+        s.inertia.inertia_com = R * Vec3(1.0, 1.0, 2.5).asDiagonal() * R.transpose();
+      },
+      {"'arm'", "triangle inequality"});
+}
+
+TEST(CoreErrors, AsymmetricInertia) {
+  expectError([](ArmSpec& s) { s.inertia.inertia_com(0, 1) = 0.05; }, {"'arm'", "not symmetric"});
+}
+
+TEST(CoreErrors, NonFiniteNumbers) {
+  expectError([](ArmSpec& s) { s.inertia.mass = kNaN; }, {"'arm'", "non-finite"});
+  expectError([](ArmSpec& s) { s.inertia.com.y() = kInf; }, {"'arm'", "non-finite"});
+  expectError([](ArmSpec& s) { s.inertia.inertia_com(2, 2) = kNaN; }, {"'arm'", "non-finite"});
+  expectError([](ArmSpec& s) { s.placement.p.x() = kNaN; }, {"'arm'", "placement is not finite"});
+  expectError([](ArmSpec& s) { s.placement.R(1, 1) = kNaN; }, {"'arm'", "placement is not finite"});
+  expectError([](ArmSpec& s) { s.axis.z() = kNaN; }, {"'arm'", "axis"});
+  ModelBuilder b;
+  b.addBody("base", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good());
+  b.setGravity(Vec3(0, 0, kNaN));
+  EXPECT_THROW(b.build(), ModelError);
+}
+
+TEST(CoreErrors, ZeroAxis) {
+  for (JointType t : {JointType::Revolute, JointType::Continuous, JointType::Prismatic,
+                      JointType::Planar})
+    expectError([t](ArmSpec& s) { s.type = t; s.axis = Vec3::Zero(); }, {"'arm'", "axis is zero"});
+  // A non-unit axis is normalised, not rejected.
+  EXPECT_NO_THROW(build([](ArmSpec& s) { s.axis = Vec3(0, 0, 3.0); }));
+}
+
+TEST(CoreErrors, BadParentIndex) {
+  expectError([](ArmSpec& s) { s.parent = 5; }, {"'arm'", "parent index 5"});
+  expectError([](ArmSpec& s) { s.parent = 1; }, {"'arm'", "parent index 1"});  // itself
+  expectError([](ArmSpec& s) { s.parent = -2; }, {"'arm'", "parent index -2"});
+}
+
+TEST(CoreErrors, PlacementRotationNotOrthonormal) {
+  expectError([](ArmSpec& s) { s.placement.R(0, 0) = 1.1; }, {"'arm'", "orthonormal"});
+}
+
+TEST(CoreErrors, DuplicateNames) {
+  ModelBuilder b;
+  b.addBody("base", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good());
+  b.addBody("base", 0, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good());
+  EXPECT_THROW(b.build(), ModelError);
+  ModelBuilder c;
+  c.addBody("a", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good(), "j");
+  c.addBody("b", 0, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good(), "j");
+  try {
+    c.build();
+    ADD_FAILURE() << "duplicate joint name accepted";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("'j'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CoreErrors, UnknownIntegratorName) {
+  try {
+    integratorFromString("leapfrog");
+    ADD_FAILURE() << "unknown integrator accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("leapfrog"), std::string::npos);
+    EXPECT_NE(msg.find("dopri5"), std::string::npos);
+  }
+  EXPECT_EQ(integratorFromString("rk4"), IntegratorType::RK4);
+}
