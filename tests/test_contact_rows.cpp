@@ -98,7 +98,7 @@ void checkAccelerationTerms(const Model& model, const std::shared_ptr<ShapeConta
   c->reserve(model, blk);
   const ConstraintList list{c};
   ConstraintData cd(model, list);
-  const int body = c->bodyA(), m = c->rows();
+  const int body = c->bodyA(), bodyB = c->bodyB(), m = c->rows();
 
   auto rowValue = [&](double tau) {
     const VecX q = configurationAt(model, q0, v0, vd0, tau);
@@ -108,6 +108,7 @@ void checkAccelerationTerms(const Model& model, const std::shared_ptr<ShapeConta
     const Vec6 V = spatialVelocityWorld(data, body);
     VecX r(2 * m + 1);
     r.head(m) = blk.Wa.topRows(m) * V + blk.b.head(m);
+    if (bodyB >= 0) r.head(m) -= blk.Wb.topRows(m) * spatialVelocityWorld(data, bodyB);
     evaluateConstraints(model, data, list, cd, t0 + tau, q, v);
     r.segment(m, m) = cd.A * v + cd.b;
     r[2 * m] = blk.frame.gap;
@@ -120,7 +121,8 @@ void checkAccelerationTerms(const Model& model, const std::shared_ptr<ShapeConta
   c->evaluate(model, data, t0, q0, v0, blk);
   ASSERT_FALSE(blk.singular) << where << ": " << blk.singular_reason;
   const Vec6 a = spatialAccelerationWorld(data, body);
-  const VecX Wa = blk.Wa.topRows(m) * a;
+  VecX Wa = blk.Wa.topRows(m) * a;
+  if (bodyB >= 0) Wa -= blk.Wb.topRows(m) * spatialAccelerationWorld(data, bodyB);
   const VecX pred = Wa + blk.kappa.head(m);
   evaluateConstraints(model, data, list, cd, t0, q0, v0);
   const VecX pred_dense = cd.A * vd0 + cd.abias;
@@ -133,7 +135,8 @@ void checkAccelerationTerms(const Model& model, const std::shared_ptr<ShapeConta
     if (c->holonomic(k)) {
       forwardKinematics(model, data, q0, v0);
       c->evaluate(model, data, t0, q0, v0, blk);
-      const double r = blk.Wa.row(k).dot(spatialVelocityWorld(data, body)) + blk.b[k];
+      double r = blk.Wa.row(k).dot(spatialVelocityWorld(data, body)) + blk.b[k];
+      if (bodyB >= 0) r -= blk.Wb.row(k).dot(spatialVelocityWorld(data, bodyB));
       EXPECT_NEAR(fd[2 * m], r, 1e-7 * (1 + std::abs(r))) << where << " gap rate";
       EXPECT_EQ(blk.gap[k], blk.frame.gap);
     }
@@ -367,4 +370,63 @@ TEST(ContactRows, VerticalDiskRollsWithoutSlipping) {
                                                                       : blk.frame.normal),
                 1e-14);
   EXPECT_LT(vcontact.norm(), 1e-14);  // the chosen centre velocity is the rolling one
+}
+
+TEST(ContactRows, SupportCarriedByAMovingBody) {
+  // A cart (floating body 0) carries the support; body 1 rolls or slides on it.
+  // Rows act on both: W_a·V_a − W_b·V_b + b, and the acceleration form too.
+  ModelBuilder mb;
+  mb.addBody("cart", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(), someInertia(3.0));
+  mb.addBody("rider", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(), someInertia(1.0));
+  const Model model = mb.build();
+  SE3 offset;
+  offset.R = axisAngle(Vec3(1, 0, 1).normalized(), 0.4);
+  offset.p = Vec3(0.1, -0.2, 0.3);
+  const std::vector<SupportSurface> surfaces{
+      Plane{Vec3(0, 0, 0.1), Vec3(0.2, 0.1, 1).normalized()},
+      SphereSurface{Vec3(0.1, 0, 0), 1.5, SphereSurface::Side::Outside},
+      SphereSurface{Vec3(0, 0.2, 0), 2.0, SphereSurface::Side::Inside}};
+  std::mt19937 rng(77);
+  int checked = 0;
+  for (const auto& shc : shapeCases()) {
+    for (const auto& surf : surfaces) {
+      Support sup{surf, StaticMotion{offset}, "cart"};
+      sup.body = 0;
+      for (const KindCase& kc : kindsFor(shc.shape)) {
+        const auto c = makeContact(kc.kind, 1, shc.shape, sup, kc.options);
+        EXPECT_EQ(c->bodyB(), 0);
+        for (int trial = 0; trial < 2; ++trial) {
+          SE3 cart;
+          cart.R = randomQuat(rng).toRotationMatrix();
+          cart.p = randomVec(rng);
+          const SupportState S = c->supportStateAt(0.0, cart);
+          SE3 pose;
+          RowBlock probe;
+          do {
+            ASSERT_TRUE(placeNearContact(shc.shape, surf, S, rng, uniform(rng, -0.02, 0.02), pose));
+            c->evaluateOnBody(pose, Vec6::Zero(), cart, Vec6::Zero(), probe);
+          } while (probe.singular);
+          VecX q(14), v(12), vd(12);
+          q << floatingQ(cart), floatingQ(pose);
+          for (int k = 0; k < 12; ++k) {
+            v[k] = uniform(rng, -1.5, 1.5);
+            vd[k] = uniform(rng, -3, 3);
+          }
+          checkAccelerationTerms(model, c, q, v, vd, 0.3,
+                                 std::string("on cart ") + toString(kc.kind) + " " + shc.name);
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 19 * 3 * 2);
+  // The support body cannot be the contact's own body, nor be given a motion.
+  Support own{Plane{}, StaticMotion{}, "self"};
+  own.body = 1;
+  EXPECT_THROW(makeContact(ContactKind::Rolling, 1, Sphere{0.1, Vec3::Zero()}, own),
+               std::invalid_argument);
+  Support moving{Plane{}, conveyor(Vec3::UnitX()), "belt on cart"};
+  moving.body = 0;
+  EXPECT_THROW(makeContact(ContactKind::Rolling, 1, Sphere{0.1, Vec3::Zero()}, moving),
+               std::invalid_argument);
 }

@@ -68,6 +68,10 @@ ShapeContact::ShapeContact(ContactKind kind, int body, Shape shape, Support supp
     throw std::invalid_argument("contact '" + name_ + "': " + why);
   };
   if (body < 0) fail("body index must be ≥ 0 (the world cannot carry a contact shape)");
+  if (support_.body == body) fail("the support cannot be carried by the contact's own body");
+  if (support_.body < -1) fail("support body index must be ≥ −1");
+  if (support_.body >= 0 && !std::holds_alternative<StaticMotion>(support_.motion))
+    fail("a support carried by a body moves with it: give a StaticMotion (its pose on the body)");
   try {
     validateShape(shape_);
     validateSupport(support_);
@@ -135,6 +139,10 @@ bool ShapeContact::holonomic(int k) const {
 }
 
 void ShapeContact::reserve(const Model& model, RowBlock& block) const {
+  if (support_.body >= model.nbodies)
+    throw std::invalid_argument("contact '" + name_ + "': support body index " +
+                                std::to_string(support_.body) + " is out of range (the model has " +
+                                std::to_string(model.nbodies) + " bodies)");
   if (body_ >= model.nbodies)
     throw std::invalid_argument("contact '" + name_ + "': body index " + std::to_string(body_) +
                                 " is out of range (the model has " +
@@ -151,15 +159,23 @@ void ShapeContact::reserve(const Model& model, RowBlock& block) const {
   block.singular_reason.reserve(256);
 }
 
-void ShapeContact::geometry(const SE3& body_pose, const Vec6& body_velocity, double t,
-                            ContactGeometry& out) const {
-  const SupportState S = supportState(support_.motion, t);
-  contactGeometry(shape_, support_.surface, S, body_pose, body_velocity, out, geometry_options_);
+SupportState ShapeContact::supportStateAt(double t, const SE3& support_body_pose,
+                                          const Vec6& support_body_velocity) const {
+  if (support_.body < 0) return supportState(support_.motion, t);
+  SupportState S;
+  S.pose = support_body_pose * std::get<StaticMotion>(support_.motion).pose;
+  S.V = support_body_velocity;
+  return S;  // A = 0: the carrying body's acceleration enters through Wb
 }
 
-void ShapeContact::evaluateAt(const SE3& body_pose, const Vec6& body_velocity, double t,
-                              RowBlock& out) const {
-  const SupportState S = supportState(support_.motion, t);
+void ShapeContact::geometry(const SE3& body_pose, const Vec6& body_velocity, double t,
+                            ContactGeometry& out) const {
+  contactGeometry(shape_, support_.surface, supportStateAt(t), body_pose, body_velocity, out,
+                  geometry_options_);
+}
+
+void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
+                             const SupportState& S, RowBlock& out) const {
   ContactGeometry g;
   contactGeometry(shape_, support_.surface, S, body_pose, body_velocity, g, geometry_options_);
   out.m = rows_;
@@ -195,10 +211,35 @@ void ShapeContact::evaluateAt(const SE3& body_pose, const Vec6& body_velocity, d
   else out.singular_reason.clear();
 }
 
+void ShapeContact::evaluateAt(const SE3& body_pose, const Vec6& body_velocity, double t,
+                              RowBlock& out) const {
+  if (support_.body >= 0)
+    throw std::logic_error("contact '" + name_ +
+                           "': the support is carried by a body; use evaluateOnBody");
+  writeRows(body_pose, body_velocity, supportState(support_.motion, t), out);
+}
+
+void ShapeContact::evaluateOnBody(const SE3& body_pose, const Vec6& body_velocity,
+                                  const SE3& support_body_pose,
+                                  const Vec6& support_body_velocity, RowBlock& out) const {
+  writeRows(body_pose, body_velocity, supportStateAt(0.0, support_body_pose, support_body_velocity),
+            out);
+  // Every row has b = −W·V_S with V_S the carrying body's velocity: the
+  // two-body form wₐ·Vₐ − w_b·V_b with w_b = wₐ and no offset.
+  out.Wb = out.Wa;
+  out.b.setZero();
+}
+
 void ShapeContact::evaluate(const Model&, const Data& data, double t, const VecX&, const VecX&,
                             RowBlock& out) const {
   const SE3& pose = data.oMi[body_];
-  evaluateAt(pose, pose.act(data.v[body_]), t, out);
+  const Vec6 V = pose.act(data.v[body_]);
+  if (support_.body < 0) {
+    writeRows(pose, V, supportState(support_.motion, t), out);
+  } else {
+    const SE3& pb = data.oMi[support_.body];
+    evaluateOnBody(pose, V, pb, pb.act(data.v[support_.body]), out);
+  }
 }
 
 std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,

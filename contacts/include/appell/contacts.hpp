@@ -52,6 +52,8 @@ class ShapeContact : public Constraint {
   const std::string& name() const override { return name_; }
   int rows() const override { return rows_; }
   int bodyA() const override { return body_; }
+  /// The body carrying the support, or −1 (world).
+  int bodyB() const override { return support_.body; }
   std::string rowLabel(int k) const override;
   bool holonomic(int k) const override;
   void reserve(const Model& model, RowBlock& block) const override;
@@ -59,12 +61,23 @@ class ShapeContact : public Constraint {
                 RowBlock& out) const override;
 
   /// The same rows from the body's world pose and world spatial velocity
-  /// directly (what evaluate() does after reading data.oMi and data.v).
+  /// directly (what evaluate() does after reading data.oMi and data.v), for a
+  /// support that belongs to the world.
   void evaluateAt(const SE3& body_pose, const Vec6& body_velocity, double t,
                   RowBlock& out) const;
+  /// Rows against a support carried by body B (support.body ≥ 0), given B's
+  /// world pose and spatial velocity: Wb = Wa, b = 0, and κ without B's
+  /// acceleration (the engine adds −Wb·a_B).
+  void evaluateOnBody(const SE3& body_pose, const Vec6& body_velocity, const SE3& support_body_pose,
+                      const Vec6& support_body_velocity, RowBlock& out) const;
   /// The geometry alone at the given state.
   void geometry(const SE3& body_pose, const Vec6& body_velocity, double t,
                 ContactGeometry& out) const;
+  /// State of the support frame: from its motion (world supports), or from the
+  /// carrying body's pose and velocity (then A = 0: the body's acceleration
+  /// enters through Wb, not κ).
+  SupportState supportStateAt(double t, const SE3& support_body_pose = {},
+                              const Vec6& support_body_velocity = Vec6::Zero()) const;
 
   ContactKind kind() const { return kind_; }
   const Shape& shape() const { return shape_; }
@@ -73,6 +86,9 @@ class ShapeContact : public Constraint {
   const Vec3& bladeDirection() const { return blade_; }
 
  private:
+  void writeRows(const SE3& body_pose, const Vec6& body_velocity, const SupportState& S,
+                 RowBlock& out) const;
+
   ContactKind kind_;
   int body_;
   Shape shape_;
@@ -87,7 +103,8 @@ class ShapeContact : public Constraint {
 /// with the contact's name and the reason: a shape that cannot roll (box,
 /// cylinder, mesh, point) for rolling kinds, a knife edge without a blade (zero
 /// direction on a point; a sphere or ellipsoid has no blade), a shape that does
-/// not fit its bowl, a negative body index, bad shape or support parameters.
+/// not fit its bowl, a negative body index, bad shape or support parameters, a
+/// support carried by the contact's own body or given a prescribed motion.
 std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,
                                           const Support& support,
                                           const ContactOptions& options = {});

@@ -80,6 +80,11 @@ struct Support {
   SupportSurface surface;
   SupportMotion motion = StaticMotion{};
   std::string name = "ground";
+  /// −1: the support belongs to the world and moves as `motion` says.
+  /// ≥ 0: the support is fixed on that body (a cart, a rotor); `motion` must be
+  /// a StaticMotion whose pose places the support frame in the body's frame.
+  /// Rows then act on two bodies (Wa on the contact body, Wb on this one).
+  int body = -1;
 };
 
 /// State of the support frame at time t. No allocation (a PrescribedMotion
