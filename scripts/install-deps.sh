@@ -8,7 +8,7 @@ PACKAGES=(
   libeigen3-dev          # Eigen 3.4: dense linear algebra
   libfcl-dev libccd-dev  # FCL 0.7 + libccd: collision queries
   liburdfdom-dev         # urdfdom: URDF parsing
-  libtinyxml2-dev        # the <appell> scene block inside URDF files
+  libtinyxml-dev         # TinyXML (urdfdom's parser): the <appell> scene block
   libassimp-dev          # assimp: STL / OBJ / Collada meshes
   libgtest-dev           # GoogleTest
   libbenchmark-dev       # Google Benchmark
