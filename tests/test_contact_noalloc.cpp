@@ -7,21 +7,63 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cstdlib>
 #include <new>
+
+// Every allocation is counted: operator new and malloc and friends (Eigen's
+// dynamic matrices allocate through malloc), forwarding to glibc's __libc_*.
+extern "C" {
+void* __libc_malloc(size_t);
+void* __libc_calloc(size_t, size_t);
+void* __libc_realloc(void*, size_t);
+void* __libc_memalign(size_t, size_t);
+void __libc_free(void*);
+}
 
 namespace {
 std::atomic<long> g_allocations{0};
 std::atomic<bool> g_counting{false};
+inline void note() {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+}
 }  // namespace
 
-void* operator new(std::size_t n) {
-  if (g_counting) ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
+extern "C" {
+void* malloc(size_t n) {
+  note();
+  return __libc_malloc(n);
+}
+void* calloc(size_t n, size_t s) {
+  note();
+  return __libc_calloc(n, s);
+}
+void* realloc(void* p, size_t n) {
+  note();
+  return __libc_realloc(p, n);
+}
+void free(void* p) { __libc_free(p); }
+void* aligned_alloc(size_t align, size_t n) {
+  note();
+  return __libc_memalign(align, n);
+}
+int posix_memalign(void** out, size_t align, size_t n) {
+  note();
+  *out = __libc_memalign(align, n);
+  return *out ? 0 : ENOMEM;
+}
+}
+
+void* operator new(size_t n) {
+  note();
+  if (void* p = __libc_malloc(n ? n : 1)) return p;
   throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void* operator new[](size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { __libc_free(p); }
+void operator delete[](void* p) noexcept { __libc_free(p); }
+void operator delete(void* p, size_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, size_t) noexcept { __libc_free(p); }
 
 using namespace appell;
 using namespace appell::testing;
@@ -33,6 +75,14 @@ TEST(ContactNoAlloc, CounterSeesAllocations) {
   g_counting = false;
   delete p;
   EXPECT_GE(g_allocations.load(), 2);
+  g_allocations = 0;
+  g_counting = true;
+  {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(50);  // Eigen allocates through malloc
+    EXPECT_EQ(x.size(), 50);
+  }
+  g_counting = false;
+  EXPECT_GE(g_allocations.load(), 1);
 }
 
 TEST(ContactNoAlloc, EvaluateDoesNotAllocate) {
@@ -50,8 +100,12 @@ TEST(ContactNoAlloc, EvaluateDoesNotAllocate) {
         kinds.push_back(ContactKind::Rolling);
         kinds.push_back(ContactKind::RollingWithoutSpin);
       }
+      if (hasBlade(shc.shape)) kinds.push_back(ContactKind::KnifeEdge);
       for (ContactKind kind : kinds) {
-        const auto c = makeContact(kind, 0, shc.shape, suc.support);
+        ContactOptions o;
+        if (kind == ContactKind::KnifeEdge && std::holds_alternative<PointShape>(shc.shape))
+          o.blade_direction = Vec3(1, 0.2, 0.1);
+        const auto c = makeContact(kind, 0, shc.shape, suc.support, o);
         RowBlock blk;
         c->reserve(model, blk);
         SE3 pose;
