@@ -1,0 +1,298 @@
+// Equilibrium finder: minimum-norm Gauss–Newton / Levenberg–Marquardt on
+//   F(θ, λ) = [ (Q(q) + Aᵀ(q) λ) / f_s ;  g(q) / ℓ_s ],   q = retract(q_k, θ),
+// re-based at every iterate (θ = 0 at q_k, so the local coordinates stay small).
+// ∂F/∂λ = [Aᵀ; 0]/f_s exactly; ∂F/∂θ by central differences.
+// Why minimum norm: the equilibria form a manifold (seed 002: dimension ≥ the
+// number of nonholonomic rows), so J is wide or rank-deficient and the
+// Gauss–Newton step is not unique; the minimum-norm one (complete orthogonal
+// decomposition) moves least, i.e. toward the nearest point of the manifold.
+// Columns are scaled to unit norm first (θ mixes radians and metres, λ is in
+// newtons) so "minimum norm" does not favour one unit over another.
+#include <appell/equilibria.hpp>
+
+#include <appell/configuration.hpp>
+#include <appell/dynamics.hpp>
+
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace appell {
+
+namespace {
+
+class Residual {
+ public:
+  Residual(const Model& model, const ConstraintList& constraints, const EquilibriumOptions& opt)
+      : model_(model), constraints_(constraints), opt_(opt), data_(model), cd_(model, constraints),
+        zero_(VecX::Zero(model.nv)) {
+    tau_ = opt.tau.size() == 0 ? VecX::Zero(model.nv) : opt.tau;
+    for (int r = 0; r < cd_.m; ++r)
+      if (cd_.holonomic[r]) holonomic_.push_back(r);
+  }
+
+  int m() const { return cd_.m; }
+  int nh() const { return static_cast<int>(holonomic_.size()); }
+  int ne() const { return model_.nv + nh(); }
+  const ConstraintData& cd() const { return cd_; }
+
+  /// Evaluates A, gaps, b, abias and Q at q (v = 0). False when the geometry is
+  /// singular or anything is not finite.
+  bool at(const VecX& q, VecX& Q) {
+    evaluateConstraints(model_, data_, constraints_, cd_, opt_.time, q, zero_);
+    if (cd_.singular) {
+      last_singular_ = cd_.singular_reason;
+      return false;
+    }
+    Q = tau_ - nonLinearEffects(model_, data_, q, zero_);
+    return Q.allFinite() && cd_.A.allFinite() && cd_.gap.allFinite();
+  }
+
+  bool residual(const VecX& q, const VecX& lambda, double fs, double ls, VecX& F) {
+    VecX Q;
+    if (!at(q, Q)) return false;
+    F.resize(ne());
+    F.head(model_.nv) = (Q + cd_.A.transpose() * lambda) / fs;
+    for (int k = 0; k < nh(); ++k) F[model_.nv + k] = cd_.gap[holonomic_[k]] / ls;
+    return F.allFinite();
+  }
+
+  /// ∂F/∂θ at (q, λ) by central differences; false if a probe hit a singular point.
+  bool jacobianTheta(const VecX& q, const VecX& lambda, double fs, double ls, MatX& Jt) {
+    const int nv = model_.nv;
+    Jt.resize(ne(), nv);
+    VecX th = VecX::Zero(nv), qp(model_.nq), Fp, Fm;
+    const double h = opt_.fd_step;
+    for (int k = 0; k < nv; ++k) {
+      th.setZero();
+      th[k] = h;
+      retract(model_, q, th, qp);
+      if (!residual(qp, lambda, fs, ls, Fp)) return false;
+      th[k] = -h;
+      retract(model_, q, th, qp);
+      if (!residual(qp, lambda, fs, ls, Fm)) return false;
+      Jt.col(k) = (Fp - Fm) / (2 * h);
+    }
+    return true;
+  }
+
+  const std::string& lastSingular() const { return last_singular_; }
+
+ private:
+  const Model& model_;
+  const ConstraintList& constraints_;
+  const EquilibriumOptions& opt_;
+  Data data_;
+  ConstraintData cd_;
+  VecX zero_, tau_;
+  std::vector<int> holonomic_;
+  std::string last_singular_;
+};
+
+void validate(const Model& model, const VecX& q, const EquilibriumOptions& opt) {
+  if (q.size() != model.nq)
+    throw std::invalid_argument("findEquilibrium: q_guess has size " + std::to_string(q.size()) +
+                                ", the model has nq = " + std::to_string(model.nq));
+  if (!q.allFinite()) throw std::invalid_argument("findEquilibrium: q_guess is not finite");
+  if (opt.tau.size() != 0 && opt.tau.size() != model.nv)
+    throw std::invalid_argument("findEquilibrium: tau has size " + std::to_string(opt.tau.size()) +
+                                ", expected nv = " + std::to_string(model.nv) + " or empty");
+  if (!(opt.tolerance > 0) || !(opt.length_scale > 0) || !(opt.fd_step > 0) || opt.max_iterations < 1)
+    throw std::invalid_argument(
+        "findEquilibrium: tolerance, length_scale and fd_step must be positive, max_iterations ≥ 1");
+}
+
+double maxAbs(const VecX& x) { return x.size() == 0 ? 0.0 : x.lpNorm<Eigen::Infinity>(); }
+
+}  // namespace
+
+EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& constraints,
+                                  const VecX& q_guess, const EquilibriumOptions& opt) {
+  validate(model, q_guess, opt);
+  Residual res(model, constraints, opt);
+  const int nv = model.nv, m = res.m(), ne = res.ne(), nx = nv + m;
+  EquilibriumResult out;
+  for (size_t k = 0; k < constraints.size(); ++k)
+    for (int r = 0; r < constraints[k]->rows(); ++r)
+      out.row_labels.push_back(constraints[k]->name() + "/" + constraints[k]->rowLabel(r));
+
+  VecX q = q_guess;
+  normalizeQuaternions(model, q);
+  VecX Q;
+  if (!res.at(q, Q)) {
+    out.q = q;
+    out.lambda = VecX::Zero(m);
+    out.message = "no equilibrium search: the starting guess is singular (" + res.lastSingular() + ")";
+    out.residual = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  double fs = opt.force_scale;
+  if (!(fs > 0)) {
+    fs = std::max(maxAbs(Q), model.totalMass() * model.gravity.norm());
+    if (!(fs > 0)) fs = 1.0;
+  }
+  const double ls = opt.length_scale, tol = opt.tolerance;
+
+  // Start from the least-squares multipliers at the guess.
+  VecX lambda = m > 0 ? VecX(Eigen::CompleteOrthogonalDecomposition<MatX>(res.cd().A.transpose()).solve(-Q))
+                      : VecX();
+  VecX F;
+  res.residual(q, lambda, fs, ls, F);
+
+  MatX Jt, J(ne, nx), Js(ne, nx);
+  VecX D(nx), qn(model.nq), Fn, lam_n;
+  double mu = 0;
+  int it = 0, slow = 0;
+  std::string stop = "iteration limit reached";
+  bool stationary = false;
+  for (; it < opt.max_iterations; ++it) {
+    if (maxAbs(F) <= tol) break;
+    if (!res.jacobianTheta(q, lambda, fs, ls, Jt)) {
+      stop = "a finite-difference probe hit singular geometry (" + res.lastSingular() + ")";
+      break;
+    }
+    res.at(q, Q);
+    J.leftCols(nv) = Jt;
+    J.rightCols(m).setZero();
+    J.topRightCorner(nv, m) = res.cd().A.transpose() / fs;
+    for (int c = 0; c < nx; ++c) {
+      const double n = J.col(c).norm();
+      D[c] = n > 1e-300 ? n : 1.0;
+      Js.col(c) = J.col(c) / D[c];
+    }
+    const VecX grad = Js.transpose() * F;
+    if (grad.norm() <= 1e-13 * std::max(1.0, Js.norm()) * F.norm()) {
+      stationary = true;
+      stop = "the residual is stationary (a local minimum of ‖F‖ that is not zero)";
+      break;
+    }
+    bool accepted = false;
+    const double scale2 = (Js.transpose() * Js).diagonal().maxCoeff();
+    for (int tries = 0; tries < 16 && !accepted; ++tries) {
+      VecX ds;
+      if (mu == 0) {
+        ds = Eigen::CompleteOrthogonalDecomposition<MatX>(Js).solve(-F);
+      } else {
+        MatX Aug(ne + nx, nx);
+        Aug << Js, std::sqrt(mu) * MatX::Identity(nx, nx);
+        VecX rhs = VecX::Zero(ne + nx);
+        rhs.head(ne) = -F;
+        ds = Eigen::ColPivHouseholderQR<MatX>(Aug).solve(rhs);
+      }
+      const VecX dx = ds.cwiseQuotient(D);
+      retract(model, q, dx.head(nv), qn);
+      lam_n = lambda + dx.tail(m);
+      if (dx.allFinite() && res.residual(qn, lam_n, fs, ls, Fn) && Fn.norm() < F.norm()) {
+        accepted = true;
+        slow = Fn.norm() > 0.999 * F.norm() ? slow + 1 : 0;
+        q = qn;
+        lambda = lam_n;
+        F = Fn;
+        mu = mu < 1e-12 * scale2 ? 0.0 : mu / 10;
+      } else {
+        mu = mu == 0 ? 1e-6 * scale2 : mu * 10;
+      }
+    }
+    if (!accepted) {
+      stationary = true;
+      stop = "no step reduces the residual (a local minimum of ‖F‖ that is not zero)";
+      break;
+    }
+    if (slow >= 30) {
+      stop = "the residual stopped decreasing";
+      break;
+    }
+  }
+  out.iterations = it;
+
+  // Final report at q: minimum-norm multipliers, residuals, rank, dimension.
+  res.at(q, Q);
+  const ConstraintData& cd = res.cd();
+  out.q = q;
+  out.generalized_force = Q;
+  if (m > 0) {
+    Eigen::CompleteOrthogonalDecomposition<MatX> cod(cd.A.transpose());
+    cod.setThreshold(1e-10);
+    out.lambda = cod.solve(-Q);
+    out.rank_A = static_cast<int>(cod.rank());
+  } else {
+    out.lambda = VecX();
+  }
+  out.redundant_rows = m - out.rank_A;
+  out.reaction = m > 0 ? VecX(cd.A.transpose() * out.lambda) : VecX::Zero(nv);
+  out.force_residual = maxAbs(Q + out.reaction);
+  double g = 0;
+  for (int r = 0; r < m; ++r)
+    if (cd.holonomic[r]) g = std::max(g, std::abs(cd.gap[r]));
+  out.gap_residual = g;
+  out.motion_residual = maxAbs(cd.b) + maxAbs(cd.abias);
+  out.residual = std::max(out.force_residual / fs, out.gap_residual / ls);
+  const bool moving = out.motion_residual > tol * ls;
+  out.converged = out.residual <= tol && !moving;
+
+  std::ostringstream msg;
+  msg.precision(3);
+  if (out.converged) {
+    msg << "converged in " << it << " iterations: scaled residual " << out.residual;
+  } else if (out.residual <= tol && moving) {
+    msg << "no equilibrium: forces balance but the support moves here (|b| + |abias| = "
+        << out.motion_residual << "), so v = 0 is not admissible";
+  } else {
+    msg << "no equilibrium near the guess: smallest scaled residual " << out.residual
+        << " (force " << out.force_residual << ", gap " << out.gap_residual << ") after " << it
+        << " iterations; " << stop;
+  }
+  out.message = msg.str();
+  (void)stationary;
+
+  // Local dimension: directions δθ along which some δλ keeps F = 0 to first
+  // order, i.e. the null space of P ∂F/∂θ, P = 1 − U Uᵀ with U spanning range(∂F/∂λ).
+  if (res.jacobianTheta(q, out.lambda, fs, ls, Jt)) {
+    MatX PJ = Jt;
+    if (m > 0) {
+      MatX Jl = MatX::Zero(ne, m);
+      Jl.topRows(nv) = cd.A.transpose() / fs;
+      Eigen::JacobiSVD<MatX> svl(Jl, Eigen::ComputeThinU);
+      const VecX& s = svl.singularValues();
+      int r = 0;
+      while (r < s.size() && s[r] > 1e-10 * std::max(s[0], 1e-300)) ++r;
+      const MatX U = svl.matrixU().leftCols(r);
+      PJ -= U * (U.transpose() * Jt);
+    }
+    Eigen::JacobiSVD<MatX> sv(PJ, Eigen::ComputeFullV);
+    const VecX& s = sv.singularValues();
+    const double ref = std::max(Jt.norm(), 1e-300);
+    int rank = 0;
+    while (rank < s.size() && s[rank] > opt.rank_tolerance * ref) ++rank;
+    out.manifold_dimension = nv - rank;
+    out.tangent = sv.matrixV().rightCols(nv - rank);
+  }
+  return out;
+}
+
+MultiStartResult findEquilibria(const Model& model, const ConstraintList& constraints,
+                                const std::vector<VecX>& guesses, const EquilibriumOptions& options,
+                                double same_tol) {
+  MultiStartResult out;
+  VecX d(model.nv);
+  for (size_t k = 0; k < guesses.size(); ++k) {
+    out.runs.push_back(findEquilibrium(model, constraints, guesses[k], options));
+    const EquilibriumResult& r = out.runs.back();
+    if (!r.converged) continue;
+    bool dup = false;
+    for (int j : out.distinct) {
+      difference(model, out.runs[j].q, r.q, d);
+      if (d.lpNorm<Eigen::Infinity>() <= same_tol) {
+        dup = true;
+        break;
+      }
+    }
+    if (!dup) out.distinct.push_back(static_cast<int>(k));
+  }
+  return out;
+}
+
+}  // namespace appell
