@@ -1,0 +1,78 @@
+// appell info: what the scene declares and what that costs.
+#include "commands.hpp"
+
+#include <appell/appell.hpp>
+#include <appell/constrained_dynamics.hpp>
+
+#include <Eigen/QR>
+
+#include <iomanip>
+#include <iostream>
+
+namespace appell::cli {
+
+namespace {
+
+const char* kHelp = R"(usage: appell info SCENE.urdf [--package-path DIRS] [--project-initial]
+
+Prints the bodies (joint type, parent, mass), the degrees of freedom (nq, nv),
+every contact with its kind, support, shape and rows, and at the initial state
+the rank of the constraint rows: redundant rows (e.g. a four-wheeled car) and
+the residuals of the initial state.
+)";
+
+}  // namespace
+
+int info(int argc, char** argv) {
+  Args args(argc, argv, 2, kLoadOptions, kLoadFlags);
+  if (args.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  const Scene scene = loadFromArgs(args, false);
+  const Model& m = scene.model;
+  std::cout << "scene " << scene.source << "\n"
+            << m.nbodies << " bodies, nq = " << m.nq << ", nv = " << m.nv
+            << ", total mass " << m.totalMass() << " kg, gravity " << m.gravity.transpose() << "\n\n";
+  std::cout << std::left << std::setw(20) << "body" << std::setw(20) << "joint" << std::setw(11)
+            << "type" << std::setw(20) << "parent" << "mass\n";
+  for (int i = 0; i < m.nbodies; ++i)
+    std::cout << std::setw(20) << m.body_names[i] << std::setw(20) << m.joint_names[i]
+              << std::setw(11) << toString(m.joints[i].type) << std::setw(20)
+              << (m.parent[i] < 0 ? std::string("world") : m.body_names[m.parent[i]])
+              << m.inertias[i].mass << "\n";
+  std::cout << "\n" << scene.contacts.size() << " contacts, " << scene.constraintRows()
+            << " constraint rows\n";
+  for (size_t k = 0; k < scene.contacts.size(); ++k) {
+    const ContactInfo& c = scene.contacts[k];
+    const Constraint& con = *scene.constraints[k];
+    std::cout << "  " << std::setw(22) << c.name << " link " << std::setw(14) << c.link
+              << " " << std::setw(20) << toString(c.kind) << " on " << std::setw(10) << c.support
+              << " shape " << c.shape_source << ", rows:";
+    for (int r = 0; r < con.rows(); ++r) std::cout << " " << con.rowLabel(r);
+    std::cout << "\n";
+  }
+  if (scene.constraintRows() > 0) {
+    Data data(m);
+    ConstraintData cd(m, scene.constraints);
+    evaluateConstraints(m, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
+    // Rank on equilibrated rows, with the solvers' default tolerance.
+    MatX A = cd.A;
+    for (int r = 0; r < A.rows(); ++r)
+      if (A.row(r).norm() > 0) A.row(r).normalize();
+    Eigen::ColPivHouseholderQR<MatX> qr(A);
+    qr.setThreshold(SolverOptions{}.rank_rel_tol);
+    const int rank = static_cast<int>(qr.rank());
+    std::cout << "at the initial state: rank " << rank << " of " << cd.m << " rows ("
+              << cd.m - rank << " redundant), " << m.nv - rank
+              << " independent velocities; residuals |Av+b| = " << velocityResidual(cd, scene.v0)
+              << ", gap = " << gapResidual(cd) << "\n";
+    if (cd.singular) std::cout << "singular contact geometry: " << cd.singular_reason << "\n";
+  }
+  const SimulationSettings& s = scene.settings;
+  std::cout << "\ndefaults: integrator " << s.integrator << ", dt " << s.dt << ", tol " << s.tol
+            << ", duration " << s.duration << " s, formulation " << s.formulation << "\n";
+  return 0;
+}
+
+}  // namespace appell::cli

@@ -1,0 +1,26 @@
+// The `appell` subcommands. Each returns the process exit code.
+#pragma once
+
+#include "args.hpp"
+
+#include <appell/urdf.hpp>
+
+namespace appell::cli {
+
+int run(int argc, char** argv);
+int info(int argc, char** argv);
+int equilibria(int argc, char** argv);
+int linearize(int argc, char** argv);
+
+/// Options every command that loads a scene accepts.
+inline const std::set<std::string> kLoadOptions = {"package-path"};
+inline const std::set<std::string> kLoadFlags = {"project-initial", "help"};
+
+/// Loads the scene named by the single positional argument.
+Scene loadFromArgs(const Args& args, bool check_initial = true);
+
+/// Velocity-coordinate names, one per entry of v (and of the local coordinates θ):
+/// "<joint>" or "<joint>.<coord>".
+std::vector<std::string> velocityNames(const Model& model);
+
+}  // namespace appell::cli

@@ -1,0 +1,39 @@
+#include "commands.hpp"
+
+#include <sstream>
+
+namespace appell::cli {
+
+Scene loadFromArgs(const Args& args, bool check_initial) {
+  if (args.positional().size() != 1)
+    throw UsageError("expected exactly one SCENE.urdf argument");
+  LoadOptions opt;
+  for (const std::string& p : args.list("package-path")) opt.package_paths.push_back(p);
+  opt.check_initial_state = check_initial;
+  opt.project_initial_state = args.has("project-initial");
+  return loadScene(args.positional()[0], opt);
+}
+
+std::vector<std::string> velocityNames(const Model& model) {
+  std::vector<std::string> names;
+  for (int i = 0; i < model.nbodies; ++i) {
+    const Joint& j = model.joints[i];
+    const std::string& n = model.joint_names[i];
+    switch (j.type) {
+      case JointType::Fixed: break;
+      case JointType::Planar:
+        for (const char* c : {"vx", "vy", "omega"}) names.push_back(n + "." + c);
+        break;
+      case JointType::Floating:
+        for (const char* c : {"wx", "wy", "wz", "vx", "vy", "vz"}) names.push_back(n + "." + c);
+        break;
+      case JointType::Ball:
+        for (const char* c : {"wx", "wy", "wz"}) names.push_back(n + "." + c);
+        break;
+      default: names.push_back(n);
+    }
+  }
+  return names;
+}
+
+}  // namespace appell::cli
