@@ -122,3 +122,8 @@ TEST(IoErrors, TerrainMeshIsDeclaredButNotSupportedYet) {
 TEST(IoErrors, MissingFile) {
   EXPECT_THROW(loadScene(kBad + "no_such_file.urdf"), SceneError);
 }
+
+TEST(IoErrors, MisspeltAttributeInSceneBlock) {
+  // A misspelt attribute would otherwise be ignored (here: a sphere of radius 0).
+  expectError("unknown_attribute.urdf", 6, {"<contact name=\"foot\">", "attribute 'raduis' does not apply to shape=\"sphere\""});
+}

@@ -197,3 +197,18 @@ TEST(IoScene, LoadFromStringResolvesAgainstBaseDir) {
     EXPECT_EQ(std::string(e.what()).rfind("moon:3: <mesh>:", 0), 0u) << e.what();
   }
 }
+
+TEST(IoScene, CollisionShapesForCollisionDetection) {
+  LoadOptions opt;
+  opt.check_initial_state = false;
+  const Scene s = loadScene(kData + "scenes/shapes.urdf", opt);
+  const auto shapes = collisionShapes(s.geometry[0]);
+  ASSERT_EQ(shapes.size(), 2u);
+  const Cylinder& c = as<Cylinder>(shapes[0]);
+  EXPECT_DOUBLE_EQ(c.radius, 0.3);
+  EXPECT_DOUBLE_EQ(c.length, 0.05);
+  EXPECT_TRUE(c.pose.p.isApprox(Vec3(0, 0.01, 0)));
+  EXPECT_DOUBLE_EQ(as<Sphere>(shapes[1]).radius, 0.05);
+  const Scene sl = loadScene(kData + "scenes/sleigh.urdf");
+  EXPECT_TRUE(as<Box>(collisionShapes(sl.geometry[0])[0]).half_extents.isApprox(Vec3(0.4, 0.2, 0.025)));
+}

@@ -12,6 +12,19 @@ const char* toString(GeometryType type) {
   return "?";
 }
 
+std::vector<Shape> collisionShapes(const LinkGeometry& link) {
+  std::vector<Shape> shapes;
+  for (const Geometry& g : link.collision) {
+    switch (g.type) {
+      case GeometryType::Box: shapes.emplace_back(Box{0.5 * g.box_size, g.origin}); break;
+      case GeometryType::Cylinder: shapes.emplace_back(Cylinder{g.radius, g.length, g.origin}); break;
+      case GeometryType::Sphere: shapes.emplace_back(Sphere{g.radius, g.origin.p}); break;
+      case GeometryType::Mesh: shapes.emplace_back(Mesh{g.mesh_path, g.mesh_scale, g.origin}); break;
+    }
+  }
+  return shapes;
+}
+
 int Scene::contactIndex(const std::string& name) const {
   for (int k = 0; k < static_cast<int>(contacts.size()); ++k)
     if (contacts[k].name == name) return k;

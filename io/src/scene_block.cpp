@@ -31,15 +31,19 @@ SupportMotion parseMotion(const XmlSource& src, const TiXmlElement* support) {
     ++count;
     if (count > 1) fail(src, m, "a support has at most one motion element");
     if (tag == "turntable") {
+      allowOnly(src, m, {"rate", "axis", "center"});
       motion = turntable(vec3(src, m, "center", Vec3::Zero()),
                          unitVector(src, m, "axis", Vec3::UnitZ()), number(src, m, "rate"));
     } else if (tag == "conveyor") {
+      allowOnly(src, m, {"velocity"});
       motion = conveyor(vec3(src, m, "velocity"));
     } else if (tag == "twist") {
+      allowOnly(src, m, {"angular", "linear"});
       ConstantTwistMotion t;
       t.twist << vec3(src, m, "angular", Vec3::Zero()), vec3(src, m, "linear", Vec3::Zero());
       motion = t;
     } else if (tag == "tilt") {
+      allowOnly(src, m, {"axis", "point", "amplitude", "frequency", "phase"});
       SinusoidalTiltMotion t;
       t.point = vec3(src, m, "point", Vec3::Zero());
       t.axis = unitVector(src, m, "axis", Vec3::UnitX());
@@ -63,6 +67,7 @@ SupportDecl parseSupport(const XmlSource& src, const TiXmlElement* e, const std:
   const std::string type = text(e, "type", "plane");
   d.support.name = d.name;
   if (type == "plane") {
+    allowOnly(src, e, {"name", "type", "normal", "offset", "point"});
     Plane p;
     p.normal = unitVector(src, e, "normal", Vec3::UnitZ());
     if (has(e, "point") && has(e, "offset"))
@@ -70,12 +75,14 @@ SupportDecl parseSupport(const XmlSource& src, const TiXmlElement* e, const std:
     p.point = has(e, "point") ? vec3(src, e, "point") : number(src, e, "offset", 0.0) * p.normal;
     d.support.surface = p;
   } else if (type == "bowl" || type == "sphere") {
+    allowOnly(src, e, {"name", "type", "center", "radius"});
     SphereSurface s;
     s.centre = vec3(src, e, "center", Vec3::Zero());
     s.radius = positive(src, e, "radius");
     s.side = type == "bowl" ? SphereSurface::Side::Inside : SphereSurface::Side::Outside;
     d.support.surface = s;
   } else if (type == "terrain") {
+    allowOnly(src, e, {"name", "type", "filename", "scale"});
     d.terrain = true;
     const std::string uri = text(src, e, "filename");
     const Vec3 scale = vec3(src, e, "scale", Vec3::Ones());
@@ -110,9 +117,34 @@ ContactKind parseKind(const XmlSource& src, const TiXmlElement* e) {
 std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement* e) {
   const bool has_shape = has(e, "shape"), has_point = has(e, "point");
   if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
-  if (has_point) return Shape{PointShape{vec3(src, e, "point")}};
-  if (!has_shape) return std::nullopt;
+  static const char* const kCommon[] = {"name", "link", "kind", "support", "mu", "direction"};
+  auto allow = [&](std::initializer_list<const char*> extra) {
+    for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+      const std::string n = a->Name();
+      bool ok = false;
+      for (const char* c : kCommon) ok = ok || n == c;
+      for (const char* c : extra) ok = ok || n == c;
+      if (!ok)
+        fail(src, e, "attribute '" + n + "' does not apply to " +
+                         (has_point ? std::string("a point contact")
+                          : has_shape ? "shape=\"" + text(e, "shape", "") + "\""
+                                      : std::string("a shape taken from the collision geometry")));
+    }
+  };
+  if (has_point) {
+    allow({"point"});
+    return Shape{PointShape{vec3(src, e, "point")}};
+  }
+  if (!has_shape) {
+    allow({"collision", "tyre_radius"});
+    return std::nullopt;
+  }
   const std::string type = text(src, e, "shape");
+  if (type == "sphere") allow({"shape", "radius", "xyz"});
+  if (type == "ellipsoid") allow({"shape", "semi_axes", "xyz", "rpy"});
+  if (type == "disk" || type == "hemisphere") allow({"shape", "radius", "xyz", "axis"});
+  if (type == "torus") allow({"shape", "radius", "tyre_radius", "xyz", "axis"});
+  if (type == "cap") allow({"shape", "radius", "xyz", "axis", "half_angle"});
   const Vec3 c = vec3(src, e, "xyz", Vec3::Zero());
   if (type == "sphere") return Shape{Sphere{positive(src, e, "radius"), c}};
   if (type == "ellipsoid") {
@@ -179,6 +211,7 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
 }
 
 JointStateDecl parseJointState(const XmlSource& src, const TiXmlElement* e) {
+  allowOnly(src, e, {"name", "position", "velocity", "xyz", "rpy", "quat"});
   JointStateDecl d;
   d.element = e;
   d.joint = text(src, e, "name");
@@ -194,6 +227,7 @@ JointStateDecl parseJointState(const XmlSource& src, const TiXmlElement* e) {
 }
 
 SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
+  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation"});
   SimulationSettings s;
   s.integrator = text(e, "integrator", s.integrator);
   try {
@@ -217,6 +251,7 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
   AppellBlock b;
   b.element = robot->FirstChildElement("appell");
   if (!b.element) return b;
+  allowOnly(src, b.element, {});
   if (b.element->NextSiblingElement("appell")) fail(src, b.element->NextSiblingElement("appell"),
                                                     "more than one <appell> block");
   std::set<std::string> supports, contacts;
@@ -224,6 +259,7 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
   for (const TiXmlElement* e = b.element->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string tag = e->Value();
     if (tag == "gravity") {
+      allowOnly(src, e, {"xyz"});
       if (have_gravity) fail(src, e, "gravity is given twice");
       have_gravity = true;
       b.gravity = vec3(src, e, "xyz");
@@ -236,12 +272,14 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
       if (!contacts.insert(d.name).second) fail(src, e, "contact name '" + d.name + "' is used twice");
       b.contacts.push_back(std::move(d));
     } else if (tag == "initial") {
+      allowOnly(src, e, {});
       for (const TiXmlElement* j = e->FirstChildElement(); j; j = j->NextSiblingElement()) {
         if (std::string(j->Value()) != "joint")
           fail(src, j, "unknown element in <initial> (only <joint> is allowed)");
         b.initial.push_back(parseJointState(src, j));
       }
     } else if (tag == "effort") {
+      allowOnly(src, e, {"joint", "value"});
       b.efforts.push_back({e, text(src, e, "joint"), numbers(src, e, "value")});
     } else if (tag == "simulation") {
       if (have_simulation) fail(src, e, "<simulation> is given twice");

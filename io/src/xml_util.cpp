@@ -89,6 +89,18 @@ Vec3 vec3(const XmlSource& src, const TiXmlElement* e, const char* attr, const V
   return has(e, attr) ? vec3(src, e, attr) : fallback;
 }
 
+void allowOnly(const XmlSource& src, const TiXmlElement* e, std::initializer_list<const char*> allowed) {
+  for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+    bool ok = false;
+    for (const char* name : allowed) ok = ok || std::string(a->Name()) == name;
+    if (ok) continue;
+    std::string list;
+    for (const char* name : allowed) list += (list.empty() ? "" : ", ") + std::string(name);
+    fail(src, e, "unknown attribute '" + std::string(a->Name()) + "' (allowed here: " +
+                     (list.empty() ? std::string("none") : list) + ")");
+  }
+}
+
 Mat3 rpyToMatrix(const Vec3& rpy) {
   return axisAngle(Vec3::UnitZ(), rpy.z()) * axisAngle(Vec3::UnitY(), rpy.y()) *
          axisAngle(Vec3::UnitX(), rpy.x());

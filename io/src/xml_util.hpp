@@ -6,6 +6,7 @@
 
 #include <tinyxml.h>
 
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +40,10 @@ std::vector<double> numbers(const XmlSource& src, const TiXmlElement* e, const c
                             int count = -1);  ///< required; count −1: any (≥ 1)
 Vec3 vec3(const XmlSource& src, const TiXmlElement* e, const char* attr);
 Vec3 vec3(const XmlSource& src, const TiXmlElement* e, const char* attr, const Vec3& fallback);
+
+/// Throws unless every attribute of `e` is one of `allowed` (a misspelt
+/// attribute would otherwise be ignored silently).
+void allowOnly(const XmlSource& src, const TiXmlElement* e, std::initializer_list<const char*> allowed);
 
 /// `<origin xyz rpy>` child of `e` (identity if absent), as URDF defines it:
 /// R = Rz(yaw) Ry(pitch) Rx(roll).

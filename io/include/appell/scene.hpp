@@ -60,6 +60,11 @@ struct LinkGeometry {
   std::vector<Geometry> collision;
 };
 
+/// A link's collision geometry as contacts-module shapes in the body frame
+/// (Box, Cylinder, Sphere, Mesh; collision detection, not rolling), in
+/// document order.
+std::vector<Shape> collisionShapes(const LinkGeometry& link);
+
 /// One declared contact, index-aligned with Scene::constraints. The shape is
 /// in the body frame (a link's frame: every link is a body).
 struct ContactInfo {
