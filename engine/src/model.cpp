@@ -1,5 +1,9 @@
 #include <appell/model.hpp>
 
+#include <appell/configuration.hpp>
+#include <appell/data.hpp>
+#include <appell/dynamics.hpp>
+
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
@@ -108,6 +112,37 @@ void checkInertia(const std::string& body, const Inertia& I, bool may_be_massles
   }
 }
 
+// A massless moving body is harmless only when the bodies it carries give every
+// direction of its joint some inertia. Otherwise M is singular — e.g. a
+// massless floating frame carrying a wheel on a revolute joint: frame and wheel
+// can counter-rotate at no cost — and ABA would return huge numbers instead of
+// an error. The joint-space articulated inertia D = Sᵀ Iᴬ S (Featherstone 2008,
+// §7.3) of each such body must be positive definite; it is read off one ABA
+// pass at the neutral and at two random configurations.
+void checkMasslessJoints(const Model& m) {
+  bool any = false;
+  for (int i = 0; i < m.nbodies; ++i) any |= m.joints[i].nv > 0 && m.inertias[i].mass == 0;
+  if (!any) return;
+  Data data(m);
+  std::mt19937 rng(12345);
+  const VecX zero = VecX::Zero(m.nv);
+  for (int trial = 0; trial < 3; ++trial) {
+    const VecX q = trial == 0 ? neutralConfiguration(m) : randomConfiguration(m, rng);
+    aba(m, data, q, zero, zero);
+    for (int i = 0; i < m.nbodies; ++i) {
+      const Joint& j = m.joints[i];
+      if (j.nv == 0 || m.inertias[i].mass != 0) continue;
+      const MatX D = j.S.transpose() * data.IA[i] * j.S;
+      const Eigen::SelfAdjointEigenSolver<MatX> eig(D);
+      const double scale = std::max(1e-300, data.IA[i].norm());
+      if (eig.eigenvalues().minCoeff() <= 1e-12 * scale)
+        fail(m.body_names[i],
+             "massless body on a moving joint whose motion meets no inertia (the bodies it "
+             "carries can move so as to cancel it): the mass matrix would be singular");
+    }
+  }
+}
+
 }  // namespace
 
 Model ModelBuilder::build() const {
@@ -193,6 +228,7 @@ Model ModelBuilder::build() const {
     for (int b = i; b >= 0; b = m.parent[b]) path.push_back(b);
     m.support.push_back(path);
   }
+  checkMasslessJoints(m);
   return m;
 }
 
