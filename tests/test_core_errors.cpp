@@ -90,6 +90,38 @@ TEST(CoreErrors, ZeroMassOnAMovingLeaf) {
   }
 }
 
+// A massless body may move only if what it carries resists its motion in every
+// direction; otherwise the mass matrix is singular and ABA would return huge
+// numbers silently.
+TEST(CoreErrors, MasslessBodyWhoseMotionMeetsNoInertia) {
+  {
+    ModelBuilder b;  // free-floating massless frame + wheel: they can counter-rotate
+    b.addBody("virtual_base", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(), Inertia{});
+    b.addBody("wheel", 0, SE3::Identity(), JointType::Revolute, Vec3::UnitZ(), good());
+    try {
+      b.build();
+      ADD_FAILURE() << "singular model accepted";
+    } catch (const ModelError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("'virtual_base'"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("singular"), std::string::npos) << msg;
+    }
+  }
+  {
+    ModelBuilder b;  // two coaxial revolutes through one point, the first massless
+    b.addBody("hub", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitY(), Inertia{});
+    b.addBody("rotor", 0, SE3::Identity(), JointType::Revolute, Vec3::UnitY(), good());
+    EXPECT_THROW(b.build(), ModelError);
+  }
+  {
+    ModelBuilder b;  // the usual URDF massless base_link rigidly carrying the mass: fine
+    b.addBody("base_link", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(), Inertia{});
+    b.addBody("chassis", 0, SE3::Identity(), JointType::Fixed, Vec3::UnitZ(), good());
+    b.addBody("wheel", 1, SE3::Identity(), JointType::Revolute, Vec3::UnitZ(), good());
+    EXPECT_NO_THROW(b.build());
+  }
+}
+
 TEST(CoreErrors, ZeroMassWithRotationalInertia) {
   expectError([](ArmSpec& s) { s.inertia.mass = 0; s.type = JointType::Fixed; },
               {"'arm'", "zero mass but non-zero rotational inertia"});
