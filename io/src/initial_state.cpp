@@ -43,6 +43,11 @@ std::string describeRow(const Scene& scene, const ConstraintData& cd, int row) {
                    cd.singular_reason);
 }
 
+void notFinite(const Scene& scene, const InitialStateReport& r) {
+  if (!std::isfinite(r.velocity_residual) || !std::isfinite(r.gap_residual))
+    throw SceneError(scene.source + ": initial state: the constraint rows are not finite there");
+}
+
 }  // namespace
 
 InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
@@ -63,6 +68,7 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
   if (cd.singular) singular(scene, cd);
   report.velocity_residual = velocityResidual(cd, scene.v0);
   report.gap_residual = gapResidual(cd);
+  notFinite(scene, report);
   if (report.velocity_residual <= tol && report.gap_residual <= tol) return report;
 
   if (!project) {
@@ -96,6 +102,7 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
     ++report.iterations;
     evaluateConstraints(model, data, scene.constraints, cd, 0.0, q, scene.v0);
     if (cd.singular) singular(scene, cd);
+    if (!std::isfinite(gapResidual(cd))) notFinite(scene, {0, gapResidual(cd), false, 0});
   }
   // Velocities: the M-metric projection onto A v + b = 0 (the impulse that
   // removes the violation with the least kinetic energy).
@@ -110,6 +117,7 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
   report.velocity_residual = velocityResidual(cd, v);
   report.gap_residual = gapResidual(cd);
   report.projected = true;
+  notFinite(scene, report);
   if (report.velocity_residual > tol || report.gap_residual > tol) {
     const Worst w = worstRow(cd, v);
     std::ostringstream s;
