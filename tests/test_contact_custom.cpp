@@ -175,8 +175,8 @@ TEST(ContactFactory, BadDeclarationsAreClearErrors) {
                      "radius");
   expectContactError(ContactKind::Rolling, 0, Disk{0.3, Vec3::Zero(), Vec3(0, 2, 0)}, ground,
                      none, "unit vector");
-  expectContactError(ContactKind::Rolling, 0, Torus{0.1, 0.2, Vec3::Zero(), Vec3::UnitY()},
-                     ground, none, "minor radius");
+  expectContactError(ContactKind::Rolling, 0, Torus{0.0, 0.2, Vec3::Zero(), Vec3::UnitY()},
+                     ground, none, "major radius");
   expectContactError(ContactKind::Rolling, 0,
                      SphericalCap{0.3, Vec3::Zero(), -Vec3::UnitZ(), 4.0}, ground, none,
                      "half-angle");

@@ -40,7 +40,8 @@ const char* toString(ContactKind kind) {
 
 ContactKind contactKindFromString(const std::string& text) {
   if (text == "rolling") return ContactKind::Rolling;
-  if (text == "rolling_without_spin" || text == "rolling-without-spin" || text == "rubber")
+  if (text == "rolling_without_spin" || text == "rolling-without-spin" || text == "rolling_no_spin" ||
+      text == "rubber")
     return ContactKind::RollingWithoutSpin;
   if (text == "knife_edge" || text == "knife-edge" || text == "knife") return ContactKind::KnifeEdge;
   if (text == "sliding") return ContactKind::Sliding;

@@ -106,7 +106,6 @@ void validateShape(const Shape& shape) {
           [](const Torus& s) {
             checkRadius("torus", "major radius", s.major, false);
             checkRadius("torus", "minor (tyre) radius", s.minor, true);
-            if (s.minor >= s.major) fail("torus", "minor radius must be smaller than the major radius");
             if (!finite(s.centre)) fail("torus", "centre must be finite");
             checkAxis("torus", s.axis);
           },

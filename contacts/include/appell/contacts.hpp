@@ -30,7 +30,7 @@ namespace appell {
 enum class ContactKind { Rolling, RollingWithoutSpin, KnifeEdge, Sliding };
 
 const char* toString(ContactKind kind);
-/// Parses "rolling", "rolling_without_spin" (or "rubber"), "knife_edge",
+/// Parses "rolling", "rolling_without_spin" (or "rolling_no_spin", "rubber"), "knife_edge",
 /// "sliding"; throws std::invalid_argument naming the text otherwise.
 ContactKind contactKindFromString(const std::string& text);
 
