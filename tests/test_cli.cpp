@@ -1,0 +1,102 @@
+// The `appell` command as a user meets it: exit codes, messages that name the
+// problem, and a run whose summary reports conserved energy.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <string>
+
+namespace {
+
+const std::string kAppell = std::string(APPELL_BINARY_DIR) + "/cli/appell";
+const std::string kDisk = std::string(APPELL_SOURCE_DIR) + "/examples/rolling_disk/rolling_disk.urdf";
+
+struct Result {
+  int status;
+  std::string output;
+};
+
+Result sh(const std::string& args) {
+  Result r{-1, ""};
+  FILE* p = popen((kAppell + " " + args + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) r.output.append(buf, n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+double field(const std::string& text, const std::string& pattern) {
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex(pattern))) return std::nan("");
+  return std::stod(m[1]);
+}
+
+}  // namespace
+
+TEST(Cli, HelpAndUsage) {
+  EXPECT_EQ(sh("--help").status, 0);
+  for (const char* cmd : {"run", "info", "equilibria", "linearize"}) {
+    const Result r = sh(std::string(cmd) + " --help");
+    EXPECT_EQ(r.status, 0) << cmd;
+    EXPECT_NE(r.output.find("usage: appell " + std::string(cmd)), std::string::npos) << r.output;
+  }
+  EXPECT_EQ(sh("fly").status, 2);
+  const Result bad = sh("run " + kDisk + " --formulation quantum");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.output.find("quantum"), std::string::npos) << bad.output;
+  EXPECT_EQ(sh("run " + kDisk + " --duration -1").status, 2);
+  EXPECT_EQ(sh("run " + kDisk + " --bogus 3").status, 2);
+}
+
+TEST(Cli, BadSceneNamesTheFile) {
+  const std::string path = std::string(APPELL_BINARY_DIR) + "/cli_bad_scene.urdf";
+  std::ofstream(path) << "<robot name='x'><link name='a'></robot>";
+  const Result r = sh("run " + path);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("cli_bad_scene.urdf"), std::string::npos) << r.output;
+  const Result missing = sh("info /nonexistent/scene.urdf");
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.output.find("/nonexistent/scene.urdf"), std::string::npos) << missing.output;
+}
+
+TEST(Cli, InfoReportsRowsAndRank) {
+  const Result r = sh("info " + kDisk);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("nq = 7, nv = 6"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("rank 3 of 3 rows (0 redundant)"), std::string::npos) << r.output;
+}
+
+TEST(Cli, RunConservesEnergyAndWritesTheTrajectory) {
+  const std::string csv = std::string(APPELL_BINARY_DIR) + "/cli_disk.csv";
+  for (const char* f : {"tree", "kkt", "appell"}) {
+    const Result r = sh("run " + kDisk + " --duration 1 --quiet --formulation " + f + " --out " + csv);
+    ASSERT_EQ(r.status, 0) << r.output;
+    // A rolling disk is passive and time-independent: the reactions do no work.
+    EXPECT_LT(field(r.output, R"(\(([-+0-9.e]+) relative\))"), 1e-8) << r.output;
+    EXPECT_LT(field(r.output, R"(max \|Av\+b\| = ([-+0-9.e]+))"), 1e-10) << r.output;
+    EXPECT_LT(field(r.output, R"(max \|gap\| = ([-+0-9.e]+))"), 1e-10) << r.output;
+    std::ifstream in(csv);
+    std::string header, row;
+    std::getline(in, header);
+    EXPECT_EQ(header.rfind("time,q:root_joint.x", 0), 0u) << header;
+    EXPECT_NE(header.find("lambda:rim.normal"), std::string::npos) << header;
+    int rows = 0;
+    while (std::getline(in, row)) ++rows;
+    EXPECT_GT(rows, 10);
+  }
+}
+
+TEST(Cli, EquilibriumOfTheUprightDisk) {
+  // An upright disk at rest is an equilibrium: its centre of mass is above the
+  // contact, the normal load is m g = 9.81 N and nothing else pushes. The set of
+  // such states is 4-dimensional: position (x, y), heading and spin angle are free.
+  const Result r = sh("equilibria " + kDisk + " --starts 1");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("1 distinct equilibria found"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("local dimension of the equilibrium set: 4"), std::string::npos) << r.output;
+  EXPECT_NEAR(field(r.output, R"(rim/normal\s+([-+0-9.e]+))"), 9.81, 1e-9) << r.output;
+}
