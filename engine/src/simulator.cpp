@@ -248,9 +248,12 @@ StepStatus Simulator::advanceTo(double t_end, double h) {
   while (t_end - t_ > eps) {
     const double remaining = t_end - t_;
     const double want = adaptive ? h_suggest_ : h;
-    const bool last = want >= remaining;
+    // Absorb a remainder below eps into the last step rather than leave it.
+    const bool last = want >= remaining - eps;
     st = step(last ? remaining : want);
     if (!st.ok) return st;
+    // Land exactly on t_end (t + (t_end − t) may differ from t_end by an ulp).
+    if (last && st.h_taken == remaining) t_ = t_end;
     // A step shortened to land on t_end says nothing about the next one.
     if (adaptive && (!last || st.h_taken < remaining)) h_suggest_ = st.h_next;
   }
