@@ -33,11 +33,12 @@ std::unique_ptr<Simulator> simulate(const Scene& s, Formulation f = Formulation:
   auto sim = std::make_unique<Simulator>(s.model, s.constraints,
                                          makeSolver(f, s.model, s.constraints),
                                          IntegratorType::DormandPrince54, io);
-  sim->setState(0.0, s.q0, s.v0);
   if (s.tau.size() == s.model.nv && s.tau.cwiseAbs().maxCoeff() > 0) {
     const VecX tau = s.tau;
     sim->setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
   }
+  // After the joint forces: setState evaluates λ and v̇ for reports with them.
+  sim->setState(0.0, s.q0, s.v0);
   return sim;
 }
 

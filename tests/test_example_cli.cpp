@@ -1,0 +1,203 @@
+// Smoke tests of the example scenes through the built programs: `appell run`
+// and `appell info` on every example (exit status 0, the summary's residual,
+// energy and redundancy lines), and the two generators (make_ntrailer,
+// make_meshes) reproducing the committed files. Needs the `appell` command
+// and the example programs built in the same build tree.
+#include <appell/urdf.hpp>
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+namespace appell {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSource = APPELL_SOURCE_DIR;
+const std::string kBinary = APPELL_BINARY_DIR;
+
+std::string example(const std::string& rel) { return kSource + "/examples/" + rel; }
+
+struct Output {
+  int status = -1;
+  std::string text;  ///< stdout and stderr
+};
+
+Output runCommand(const std::string& cmd) {
+  Output out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.text.append(buf.data(), n);
+  const int st = pclose(p);
+  out.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return out;
+}
+
+std::string program(const std::string& rel) {
+  const std::string path = kBinary + "/" + rel;
+  EXPECT_TRUE(fs::exists(path)) << path << " is not built (build the target first)";
+  return path;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+double number(const std::string& text, const std::string& pattern) {
+  std::smatch m;
+  const std::regex re(pattern);
+  if (!std::regex_search(text, m, re)) {
+    ADD_FAILURE() << "no match for /" << pattern << "/ in:\n" << text;
+    return std::nan("");
+  }
+  return std::stod(m[1].str());
+}
+
+class TempDir {
+ public:
+  TempDir() : path_(fs::temp_directory_path() / ("appell_examples_" + std::to_string(getpid()))) {
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+struct RunCase {
+  const char* file;
+  int redundant;
+  bool passive;
+};
+
+class ExampleRun : public ::testing::TestWithParam<RunCase> {};
+
+TEST_P(ExampleRun, RunsWithTheExpectedSummary) {
+  const RunCase c = GetParam();
+  const Output o = runCommand(program("cli/appell") + " run " + example(c.file) +
+                              " --duration 1 --quiet");
+  ASSERT_EQ(o.status, 0) << o.text;
+  EXPECT_LT(number(o.text, R"(max \|Av\+b\| = ([0-9.eE+-]+))"), 1e-10) << o.text;
+  EXPECT_LT(number(o.text, R"(max \|gap\| = ([0-9.eE+-]+))"), 1e-10) << o.text;
+  EXPECT_EQ(number(o.text, R"(redundant\s+([0-9]+) rows)"), c.redundant) << o.text;
+  EXPECT_NE(o.text.find("events       none"), std::string::npos) << o.text;
+  EXPECT_EQ(o.text.find("would lift off"), std::string::npos) << o.text;
+  if (c.passive)
+    EXPECT_LT(number(o.text, R"(\(([0-9.eE+-]+) relative\))"), 1e-8) << o.text;
+  else
+    EXPECT_NE(o.text.find("energy is not conserved"), std::string::npos) << o.text;
+  // info: the same rows and redundancy at the initial state.
+  const Output info = runCommand(program("cli/appell") + " info " + example(c.file));
+  ASSERT_EQ(info.status, 0) << info.text;
+  EXPECT_EQ(number(info.text, R"(\(([0-9]+) redundant\))"), c.redundant) << info.text;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllExamples, ExampleRun,
+    ::testing::Values(RunCase{"rolling_disk/rolling_disk.urdf", 0, true},
+                      RunCase{"ball_turntable/ball_turntable.urdf", 0, false},
+                      RunCase{"sleigh/sleigh.urdf", 0, true},
+                      RunCase{"hemisphere_bowl/hemisphere_bowl.urdf", 0, true},
+                      RunCase{"ellipsoid/ellipsoid.urdf", 0, true},
+                      RunCase{"diff_drive/diff_drive.urdf", 1, false},
+                      RunCase{"diff_drive/diff_drive_turn.urdf", 1, false},
+                      RunCase{"car/car.urdf", 3, true},
+                      RunCase{"ntrailer/ntrailer3.urdf", 0, false}),
+    [](const ::testing::TestParamInfo<RunCase>& p) {
+      std::string n = p.param.file;
+      n = n.substr(n.find('/') + 1);
+      return n.substr(0, n.find('.'));
+    });
+
+TEST(ExampleCli, CarInfoReportsRankAndRedundancy) {
+  const Output o = runCommand(program("cli/appell") + " info " + example("car/car.urdf"));
+  ASSERT_EQ(o.status, 0) << o.text;
+  EXPECT_NE(o.text.find("rank 9 of 12 rows (3 redundant)"), std::string::npos) << o.text;
+  EXPECT_NE(o.text.find("1 independent velocities"), std::string::npos) << o.text;
+}
+
+TEST(ExampleCli, CarRunWritesLoadsOnAllFourWheels) {
+  TempDir dir;
+  const std::string csv = dir / "car.csv";
+  const Output o = runCommand(program("cli/appell") + " run " + example("car/car.urdf") +
+                              " --duration 0.5 --quiet --out " + csv);
+  ASSERT_EQ(o.status, 0) << o.text;
+  for (const char* w : {"front_left", "front_right", "rear_left", "rear_right"}) {
+    // "  front_left_tyre    normal load 71.12 … 71.12 N"
+    const double load = number(o.text, std::string(w) + R"(_tyre\s+normal load ([0-9.]+))");
+    EXPECT_NEAR(load, w[0] == 'f' ? 71.1225 : 46.5975, 0.01) << o.text;
+  }
+  const std::string header = readFile(csv).substr(0, readFile(csv).find('\n'));
+  EXPECT_NE(header.find("lambda:rear_right_tyre.normal"), std::string::npos) << header;
+}
+
+// ---------------------------------------------------------------------------
+// Generators.
+
+TEST(ExampleGenerators, MakeNTrailerReproducesTheCommittedFile) {
+  TempDir dir;
+  const std::string out = dir / "ntrailer3.urdf";
+  const Output o = runCommand(program("examples/example_make_ntrailer") + " 3 " + out);
+  ASSERT_EQ(o.status, 0) << o.text;
+  EXPECT_EQ(readFile(out), readFile(example("ntrailer/ntrailer3.urdf")))
+      << "examples/ntrailer/ntrailer3.urdf is stale: regenerate it (docs/examples.md)";
+}
+
+TEST(ExampleGenerators, MakeNTrailerScalesToTenTrailers) {
+  TempDir dir;
+  const std::string out = dir / "ntrailer10.urdf";
+  const Output o = runCommand(program("examples/example_make_ntrailer") + " 10 " + out);
+  ASSERT_EQ(o.status, 0) << o.text;
+  const Scene s = loadScene(out);
+  EXPECT_EQ(s.model.nv, 6 + 2 * 10);
+  EXPECT_EQ(s.constraintRows(), 4 + 2 * 10);
+  const Output run = runCommand(program("cli/appell") + " run " + out + " --duration 1 --quiet");
+  ASSERT_EQ(run.status, 0) << run.text;
+  EXPECT_EQ(number(run.text, R"(redundant\s+([0-9]+) rows)"), 0) << run.text;
+  EXPECT_LT(number(run.text, R"(max \|Av\+b\| = ([0-9.eE+-]+))"), 1e-10) << run.text;
+}
+
+TEST(ExampleGenerators, MakeNTrailerRejectsBadArguments) {
+  for (const char* args : {"", " 0", " -2", " 3x", " abc"}) {
+    const Output o = runCommand(program("examples/example_make_ntrailer") + args);
+    EXPECT_EQ(o.status, 2) << "args '" << args << "': " << o.text;
+    EXPECT_FALSE(o.text.empty());
+  }
+}
+
+TEST(ExampleGenerators, MakeMeshesReproducesTheCommittedMeshes) {
+  TempDir dir;
+  const std::string out = dir / "meshes";
+  const Output o = runCommand(program("examples/example_make_meshes") + " " + out);
+  ASSERT_EQ(o.status, 0) << o.text;
+  EXPECT_NE(o.text.find("2176 triangles"), std::string::npos) << o.text;
+  for (const char* f : {"wheel.stl", "wheel.dae"}) {
+    const std::string made = readFile(out + "/" + f), committed = readFile(example(std::string("diff_drive/meshes/") + f));
+    EXPECT_FALSE(made.empty()) << f;
+    EXPECT_LT(made.size(), 200u * 1024) << f;
+    EXPECT_TRUE(made == committed) << "examples/diff_drive/meshes/" << f
+                                   << " is stale: regenerate it (docs/examples.md)";
+  }
+}
+
+}  // namespace
+}  // namespace appell
