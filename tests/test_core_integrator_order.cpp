@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ostream>
 #include <vector>
 
 using namespace appell;
@@ -154,6 +155,8 @@ struct OrderCase {
   int order;
   std::vector<int> steps[2];  ///< step counts per scene (each doubling halves h)
 };
+
+void PrintTo(const OrderCase& c, std::ostream* os) { *os << toString(c.type); }
 
 class IntegratorOrder : public ::testing::TestWithParam<OrderCase> {};
 
