@@ -265,7 +265,7 @@ TEST(ExampleEllipsoid, CentreHeightFollowsSupportFunctionEnergyConserved) {
 // ---------------------------------------------------------------------------
 // Every example scene: the tree solver agrees with the dense multiplier
 // (KKT) reference at the initial state (v̇, Aᵀλ and the minimum-norm λ), and
-// over a short run.
+// over a short run; the dense Appell/Maggi solver agrees at the initial state.
 
 class ExampleFormulations : public ::testing::TestWithParam<const char*> {};
 
@@ -282,6 +282,12 @@ TEST_P(ExampleFormulations, TreeMatchesMultipliers) {
   EXPECT_LT((a.lambda - b.lambda).cwiseAbs().maxCoeff(), 1e-8 * fs)
       << "tree λ " << a.lambda.transpose() << "\nkkt  λ " << b.lambda.transpose();
   EXPECT_EQ(a.redundant, b.redundant);
+  // The dense Appell/Maggi (null-space) formulation gives the same v̇ and Aᵀλ.
+  auto maggi = simulate(s, Formulation::Appell);
+  const ConstrainedResult& c = maggi->dynamics();
+  ASSERT_TRUE(c.ok) << c.error;
+  EXPECT_LT((c.vdot - b.vdot).cwiseAbs().maxCoeff(), 1e-9 * vs);
+  EXPECT_LT((c.reaction - b.reaction).cwiseAbs().maxCoeff(), 1e-9 * fs);
   Stats sa, sb;
   advance(*tree, 0.5, sa);
   advance(*kkt, 0.5, sb);
