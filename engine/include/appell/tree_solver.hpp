@@ -1,0 +1,74 @@
+// The O(n + m) constrained-dynamics kernel: Gauss' principle solved exactly by
+// dynamic programming on the kinematic tree (DESIGN.md §2, docs/tree-solver.md).
+//
+//   minimise ½ v̇ᵀ M v̇ + v̇ᵀ(h − τ)   subject to  A v̇ + abias = 0
+//
+// Backward pass (leaves → root), on top of the articulated-body recursion:
+// each body stacks its own constraint rows (spatial covectors on its
+// acceleration, body frame) with the rows its children could not resolve,
+// compresses them with a rank-revealing QR to at most 6, and splits its joint
+// acceleration with an SVD of K S into a particular part fixed by the rows the
+// joint resolves and a free part minimised as in ABA. Rows the joint cannot
+// move are handed to the parent; the coupling of the particular part enters
+// the parent's articulated inertia and bias through the projector P = 1 − S G⁺ K.
+// Forward pass: accelerations, then multipliers from joint force balance,
+// unrolled through the compressions with their adjoints.
+//
+// Rows between two moving bodies and joint-space rows close loops: they are
+// auxiliary unknowns, found from a small rank-revealing (SVD) Schur complement
+// after one extra tree solve per row (O(k n)).
+//
+// Exact: no iterations, no regularisation. No heap allocation inside solve()
+// or projectVelocity() once `out` has the right sizes (all workspace is sized
+// by the constructor).
+#pragma once
+
+#include <appell/constrained_dynamics.hpp>
+
+#include <memory>
+
+namespace appell {
+
+namespace detail {
+struct TreeWorkspace;
+}
+
+class TreeSolver : public ConstrainedSolver {
+ public:
+  /// Sizes every workspace for this model and constraint list. Throws
+  /// std::invalid_argument naming the constraint when one acts on no moving
+  /// body, on a body index outside the model, or writes more than 6 body rows.
+  TreeSolver(const Model& model, const ConstraintList& constraints,
+             const SolverOptions& options = {});
+  ~TreeSolver() override;
+  TreeSolver(const TreeSolver&) = delete;
+  TreeSolver& operator=(const TreeSolver&) = delete;
+
+  Formulation formulation() const override { return Formulation::Tree; }
+
+  void solve(const Model& model, Data& data, const ConstraintList& constraints,
+             ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
+             ConstrainedResult& out) override;
+
+  /// v⁺ = v − M⁻¹Aᵀμ with A v⁺ + b = 0 (the M-orthogonal projection), the
+  /// same recursion with no forces, no velocity products and the velocity
+  /// residual as right side; μ goes to `impulse`.
+  bool projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,
+                       ConstraintData& cdata, const VecX& q, VecX& v, VecX& impulse) override;
+
+  /// Number of loop-closing rows (two moving bodies or joint-space rows)
+  /// handled by the Schur complement.
+  int loopRows() const;
+  /// Why the last projectVelocity() returned false (empty otherwise).
+  const std::string& lastError() const;
+
+ private:
+  std::unique_ptr<detail::TreeWorkspace> ws_;
+};
+
+/// The tree solver behind the ConstrainedSolver interface.
+std::unique_ptr<ConstrainedSolver> makeTreeSolver(const Model& model,
+                                                  const ConstraintList& constraints,
+                                                  const SolverOptions& options = {});
+
+}  // namespace appell

@@ -1,0 +1,256 @@
+// Tree solver, backward passes (leaves → root). See docs/tree-solver.md.
+//
+// factorPass: everything that depends on the pose and the rows but not on the
+// right sides — row compression, the split of each joint by the SVD of K S,
+// and the articulated inertias with the particular/free coupling kept.
+// biasPass: the right sides — articulated bias forces and the right sides of
+// the compressed and handed-up rows; it can be replayed cheaply for the unit
+// solves of the loop closure and for the impulse solve.
+#include "tree_solver_workspace.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace appell::detail {
+
+namespace {
+
+/// Rank-revealing compression of the first `nb` rows of ws.buf:
+/// equilibrate each row (rows already below the absolute tolerance are left
+/// alone, so round-off residue of a redundant row is never blown up into a
+/// fake constraint), then Householder QR with column pivoting, Qᵀ E B = R.
+/// Keeps rows whose |R_ii| exceeds max(abs, rel·|R_00|); out = Q₁ᵀ E B.
+void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
+  const SolverOptions& o = ws.options;
+  cp.nrows = nb;
+  cp.E.resize(nb);
+  auto B = ws.buf.topRows(nb);
+  for (int r = 0; r < nb; ++r) {
+    const double n = B.row(r).norm();
+    cp.E[r] = n > o.rank_abs_tol ? 1.0 / n : 1.0;
+    B.row(r) *= cp.E[r];
+  }
+  ws.qr.compute(B);
+  const auto& R = ws.qr.matrixR();
+  const int diag = std::min(nb, 6);
+  const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * std::abs(R(0, 0)));
+  int rank = 0;
+  while (rank < diag && std::abs(R(rank, rank)) > thr) ++rank;
+  cp.rank = rank;
+  cp.Q = ws.qr.householderQ();
+  out.resize(rank, 6);
+  out.noalias() = cp.Q.leftCols(rank).transpose() * B;
+}
+
+/// Body rows of a constraint block, world covectors → body frame (adjoint of
+/// the motion transform: w_body = ᵒX_iᵀ w).
+void bodyRows(const Data& data, const ConstraintData& cdata, TreeBlock& tb) {
+  const RowBlock& blk = cdata.blocks[tb.constraint];
+  const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
+  const SE3& oMi = data.oMi[tb.body];
+  tb.Kbody.resize(tb.rows, 6);
+  for (int r = 0; r < tb.rows; ++r)
+    tb.Kbody.row(r) = oMi.actInvForce(tb.sign * W.row(r).transpose()).transpose();
+}
+
+}  // namespace
+
+void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
+                TreeWorkspace& ws) {
+  const SolverOptions& o = ws.options;
+  for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].IA = model.spatial_inertia[i];
+  ws.redundant = 0;
+
+  for (int i = model.nbodies - 1; i >= 0; --i) {
+    Node& nd = ws.nodes[i];
+    const Joint& j = model.joints[i];
+    const int p = model.parent[i];
+
+    // 1. Stack own rows and the children's unresolved rows, compressing
+    //    whenever the stack would exceed 12 rows and once at the end.
+    nd.ncomp = 0;
+    nd.nK = 0;
+    nd.K.resize(0, 6);
+    int nb = 0;
+    bool dirty = false;
+    Compression* cur = &nd.comp[0];
+    cur->nseg = 0;
+    auto flush = [&]() {
+      compress(ws, *cur, nb, nd.K);
+      nd.nK = cur->rank;
+      ws.redundant += nb - cur->rank;
+      cur = &nd.comp[++nd.ncomp];
+      cur->nseg = 0;
+      nb = nd.nK;
+      if (nb > 0) {
+        ws.buf.topRows(nb) = nd.K;
+        cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
+      }
+      dirty = false;
+    };
+    for (const Segment& g : nd.groups) {
+      int r = 0;
+      if (g.kind == Segment::Block) {
+        TreeBlock& tb = ws.blocks[g.id];
+        bodyRows(data, cdata, tb);
+        r = tb.rows;
+      } else {
+        r = ws.nodes[g.id].npass;
+      }
+      if (r == 0) continue;
+      if (nb + r > 12) flush();
+      if (g.kind == Segment::Block)
+        ws.buf.middleRows(nb, r) = ws.blocks[g.id].Kbody;
+      else
+        ws.buf.middleRows(nb, r) = ws.nodes[g.id].KpassParent;
+      cur->seg[cur->nseg++] = {g.kind, g.id, r};
+      nb += r;
+      dirty = true;
+    }
+    if (dirty) flush();
+
+    // 2. Split the joint: G = K S = U Σ Vᵀ; rows along U₁ fix V₁ᵀ q̈, rows
+    //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.
+    const int nv = j.nv, nK = nd.nK;
+    int rho = 0;
+    if (nK > 0 && nv > 0) {
+      const SmallMat G = nd.K * j.S;
+      ws.svd.compute(G, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const auto& s = ws.svd.singularValues();
+      const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * s(0));
+      while (rho < s.size() && s(rho) > thr) ++rho;
+      const auto& Um = ws.svd.matrixU();
+      const auto& Vm = ws.svd.matrixV();
+      if (rho > 0)
+        nd.Gpinv.noalias() = Vm.leftCols(rho) * s.head(rho).cwiseInverse().asDiagonal() *
+                             Um.leftCols(rho).transpose();
+      nd.U2 = Um.rightCols(nK - rho);
+      nd.V2 = Vm.rightCols(nv - rho);
+    } else {
+      nd.U2.setIdentity(nK, nK);
+      nd.V2.setIdentity(nv, nv);
+    }
+    nd.rankG = rho;
+    nd.npass = nK - rho;
+    nd.nf = nv - rho;
+    if (nd.npass > 0) {
+      nd.Kpass.noalias() = nd.U2.transpose() * nd.K;
+      if (p >= 0) {
+        nd.KpassParent.resize(nd.npass, 6);
+        for (int r = 0; r < nd.npass; ++r)
+          nd.KpassParent.row(r) = data.liMi[i].actForce(nd.Kpass.row(r).transpose()).transpose();
+      } else {
+        ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
+      }
+    } else {
+      nd.Kpass.resize(0, 6);
+      nd.KpassParent.resize(0, 6);
+    }
+
+    // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
+    //    part z is eliminated as in ABA, and the parent sees Pᵀ Ia P — the
+    //    particular/free coupling the constrained-LQR equations drop.
+    if (rho > 0) {
+      nd.P.setIdentity();
+      nd.P.noalias() -= j.S * (nd.Gpinv * nd.K);
+      nd.S2.noalias() = j.S * nd.V2;
+    } else {
+      nd.S2 = j.S;
+    }
+    nd.Ia = nd.IA;
+    if (nd.nf > 0) {
+      nd.U.noalias() = nd.IA * nd.S2;
+      const SmallMat D = nd.S2.transpose() * nd.U;
+      nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
+      nd.Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
+    }
+    if (rho > 0)
+      nd.H.noalias() = nd.P.transpose() * nd.Ia * nd.P;
+    else
+      nd.H = nd.Ia;
+    if (p >= 0) {
+      const Mat6 X = data.liMi[i].toInverseMotionMatrix();
+      ws.nodes[p].IA.noalias() += X.transpose() * nd.H * X;
+    }
+  }
+}
+
+bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check) {
+  const SolverOptions& o = ws.options;
+  for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].pA = ws.nodes[i].bias0;
+  ws.failure = {};
+
+  for (int i = model.nbodies - 1; i >= 0; --i) {
+    Node& nd = ws.nodes[i];
+    const Joint& j = model.joints[i];
+    const int p = model.parent[i];
+
+    // Right sides through the recorded compressions: Qᵀ E r.
+    for (int e = 0; e < nd.ncomp; ++e) {
+      Compression& cp = nd.comp[e];
+      BufVec r(cp.nrows);
+      int off = 0;
+      for (int s = 0; s < cp.nseg; ++s) {
+        const Segment& g = cp.seg[s];
+        if (g.kind == Segment::Previous)
+          r.segment(off, g.rows) = nd.comp[e - 1].rhs;
+        else if (g.kind == Segment::Block)
+          r.segment(off, g.rows) = ws.blocks[g.id].rhs;
+        else
+          r.segment(off, g.rows) = ws.nodes[g.id].kpass;
+        off += g.rows;
+      }
+      r.array() *= cp.E.array();
+      BufVec t(cp.nrows);
+      t.noalias() = cp.Q.transpose() * r;
+      cp.rhs = t.head(cp.rank);
+      if (check && cp.nrows > cp.rank) {
+        // The dropped rows are combinations of the kept ones: their right
+        // sides must be the same combinations, or no acceleration satisfies them.
+        const double res = t.tail(cp.nrows - cp.rank).lpNorm<Eigen::Infinity>();
+        if (res > o.consistency_tol * std::max(1.0, r.lpNorm<Eigen::Infinity>())) {
+          ws.failure = {true, i, e, res};
+          return false;
+        }
+      }
+    }
+    if (nd.ncomp > 0)
+      nd.k = nd.comp[nd.ncomp - 1].rhs;
+    else
+      nd.k.resize(0);
+
+    const auto tau = ws.tau.segment(j.idx_v, j.nv);
+    Vec6 d = Vec6::Zero();
+    if (nd.rankG > 0) d.noalias() = j.S * (nd.Gpinv * nd.k);
+    if (nd.nf > 0) {
+      if (nd.rankG > 0)
+        nd.u.noalias() = nd.V2.transpose() * tau;
+      else
+        nd.u = tau;
+      nd.u.noalias() -= nd.S2.transpose() * nd.pA;
+    }
+    if (p >= 0) {
+      Vec6 pa = nd.pA;
+      if (nd.nf > 0) pa.noalias() += nd.U * (nd.Dinv * nd.u);
+      // Gradient of the child's cost-to-go in ā = X a_p + c:
+      //   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ.
+      Vec6 g = ws.use_c ? Vec6(nd.H * nd.c) : Vec6::Zero();
+      if (nd.rankG > 0) {
+        g.noalias() += nd.P.transpose() * (nd.Ia * d + pa);
+        g.noalias() += nd.K.transpose() * (nd.Gpinv.transpose() * tau);
+      } else {
+        g += pa;
+      }
+      ws.nodes[p].pA += data.liMi[i].actForce(g);
+    }
+    if (nd.npass > 0) {
+      nd.kpass.noalias() = nd.U2.transpose() * nd.k;
+      if (ws.use_c) nd.kpass.noalias() -= nd.Kpass * nd.c;
+    } else {
+      nd.kpass.resize(0);
+    }
+  }
+  return true;
+}
+
+}  // namespace appell::detail

@@ -1,0 +1,86 @@
+// Tree solver, forward pass (root → leaves): accelerations, then each body's
+// multipliers from its joint force balance, unrolled into its rows and its
+// children's handed-up rows (tree_solver_multipliers.cpp).
+#include "tree_solver_workspace.hpp"
+
+#include <algorithm>
+
+namespace appell::detail {
+
+bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check) {
+  const SolverOptions& o = ws.options;
+  for (int i = 0; i < model.nbodies; ++i) {
+    Node& nd = ws.nodes[i];
+    const Joint& j = model.joints[i];
+    const int p = model.parent[i];
+
+    Vec6 xa = p >= 0 ? data.liMi[i].actInv(ws.nodes[p].a) : data.liMi[i].actInv(ws.a_world);
+    Vec6 abar = xa;
+    if (ws.use_c) abar += nd.c;
+
+    if (p < 0 && nd.npass > 0) {
+      // Rows no joint can move act on the world's (prescribed) acceleration:
+      // they must already hold. Their multipliers are zero (minimum norm:
+      // these rows of A vanish).
+      nd.nu.setZero(nd.npass);
+      if (check) {
+        KVec lhs(nd.npass);
+        lhs.noalias() = nd.Kpass * xa;
+        const double res = (nd.kpass - lhs).lpNorm<Eigen::Infinity>();
+        const double scale =
+            std::max({1.0, nd.kpass.lpNorm<Eigen::Infinity>(), lhs.lpNorm<Eigen::Infinity>()});
+        if (res > o.consistency_tol * scale) {
+          ws.failure = {true, i, -1, res};
+          return false;
+        }
+      }
+    }
+
+    // q̈ = G⁺(k − K ā) + V₂ z,   z = D⁻¹(u − Uᵀ w),   w = ā + S G⁺(k − K ā).
+    auto qdd = ws.vdot.segment(j.idx_v, j.nv);
+    const auto tau = ws.tau.segment(j.idx_v, j.nv);
+    Vec6 w = abar;
+    if (nd.rankG > 0) {
+      KVec r = nd.k;
+      r.noalias() -= nd.K * abar;
+      KVec y(j.nv);
+      y.noalias() = nd.Gpinv * r;
+      w.noalias() += j.S * y;
+      qdd = y;
+    } else {
+      qdd.setZero();
+    }
+    Vec6 a = w;
+    if (nd.nf > 0) {
+      KVec z = nd.u;
+      z.noalias() -= nd.U.transpose() * w;
+      const KVec zz = nd.Dinv * z;
+      a.noalias() += nd.S2 * zz;
+      if (nd.rankG > 0)
+        qdd.noalias() += nd.V2 * zz;
+      else
+        qdd += zz;
+    }
+    nd.a = a;
+
+    // Multipliers of K from the joint's force balance  Gᵀ μ = Sᵀ f − τ with
+    // f = IA a + pA (the force the joint transmits, constraint forces of
+    // this body's rows excluded); the U₂ part comes from the parent.
+    if (nd.ncomp > 0) {
+      KVec& mu = nd.comp[nd.ncomp - 1].mu;
+      mu.setZero(nd.nK);
+      if (nd.rankG > 0) {
+        const Vec6 f = nd.IA * a + nd.pA;
+        KVec r(j.nv);
+        r.noalias() = j.S.transpose() * f;
+        r -= tau;
+        mu.noalias() += nd.Gpinv.transpose() * r;
+      }
+      if (nd.npass > 0) mu.noalias() += nd.U2 * nd.nu;
+      unrollNode(ws, i, nd.ncomp - 1, ws.lambda);
+    }
+  }
+  return true;
+}
+
+}  // namespace appell::detail

@@ -1,0 +1,138 @@
+// Tree solver, multipliers: unrolling the row compressions with their
+// adjoints, the reaction Aᵀλ in O(n + m), and the certificate that names the
+// constraints behind an inconsistency.
+//
+// A compression replaced the stacked rows B (right sides r) by K = Q₁ᵀ E B,
+// so a multiplier μ on K is the force Kᵀμ = Bᵀ(E Q₁ μ): the stacked rows get
+// λ = E Q₁ μ. Dropped rows (redundant) get exactly the share E Q₁ μ assigns
+// them — Aᵀλ and v̇ are exact; λ is the minimum-norm choice within each
+// compression, and unique wherever A has full row rank.
+#include "tree_solver_workspace.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace appell::detail {
+
+namespace {
+
+/// Hands the stacked-row multipliers `lam` of compression `e` to their owners.
+void distribute(TreeWorkspace& ws, Node& nd, int e, const BufVec& lam, VecX& lambda) {
+  const Compression& cp = nd.comp[e];
+  int off = 0;
+  for (int s = 0; s < cp.nseg; ++s) {
+    const Segment& g = cp.seg[s];
+    if (g.kind == Segment::Previous)
+      nd.comp[e - 1].mu = lam.segment(off, g.rows);
+    else if (g.kind == Segment::Block)
+      lambda.segment(ws.blocks[g.id].global, g.rows) = lam.segment(off, g.rows);
+    else
+      ws.nodes[g.id].nu = lam.segment(off, g.rows);
+    off += g.rows;
+  }
+}
+
+}  // namespace
+
+void unrollNode(TreeWorkspace& ws, int body, int from, VecX& lambda) {
+  Node& nd = ws.nodes[body];
+  for (int e = from; e >= 0; --e) {
+    const Compression& cp = nd.comp[e];
+    BufVec lam(cp.nrows);
+    lam.noalias() = cp.Q.leftCols(cp.rank) * cp.mu;
+    lam.array() *= cp.E.array();
+    distribute(ws, nd, e, lam, lambda);
+  }
+}
+
+void reactionForces(const Model& model, const Data& data, const ConstraintData& cdata,
+                    TreeWorkspace& ws, const VecX& lambda, VecX& reaction) {
+  for (auto& f : ws.fsub) f.setZero();
+  // Each row is a world spatial covector, i.e. a spatial force on its body.
+  for (const TreeBlock& tb : ws.blocks) {
+    const RowBlock& blk = cdata.blocks[tb.constraint];
+    const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
+    ws.fsub[tb.body].noalias() +=
+        tb.sign * W.transpose() * lambda.segment(tb.global, tb.rows);
+  }
+  reaction.setZero();
+  for (const LoopRow& lr : ws.loops) {
+    const RowBlock& blk = cdata.blocks[lr.constraint];
+    const double l = lambda[lr.global];
+    if (lr.joint_space) {
+      reaction.noalias() += l * blk.A_joint.row(lr.row).transpose();
+      continue;
+    }
+    ws.fsub[lr.bodyA] += l * blk.Wa.row(lr.row).transpose();
+    ws.fsub[lr.bodyB] -= l * blk.Wb.row(lr.row).transpose();
+  }
+  for (int i = model.nbodies - 1; i >= 0; --i) {
+    const int p = model.parent[i];
+    const Joint& j = model.joints[i];
+    if (j.nv > 0)
+      reaction.segment(j.idx_v, j.nv).noalias() +=
+          j.S.transpose() * data.oMi[i].actInvForce(ws.fsub[i]);
+    if (p >= 0) ws.fsub[p] += ws.fsub[i];
+  }
+}
+
+std::string describeFailure(const Model& model, const Data& data, TreeWorkspace& ws) {
+  const Failure f = ws.failure;
+  if (f.node < 0) return ws.last_error;  // loop closure wrote its own message
+  VecX cert = VecX::Zero(ws.m);
+  const int i = f.node;
+  for (int j = i; j < model.nbodies; ++j)
+    if (model.isAncestor(i, j)) ws.nodes[j].nu.setZero(ws.nodes[j].npass);
+  Node& nd = ws.nodes[i];
+
+  // The violated combination, pushed back to the rows it came from exactly
+  // as a multiplier would be.
+  if (f.comp >= 0) {
+    const Compression& cp = nd.comp[f.comp];
+    BufVec r(cp.nrows);
+    int off = 0;
+    for (int s = 0; s < cp.nseg; ++s) {
+      const Segment& g = cp.seg[s];
+      if (g.kind == Segment::Previous)
+        r.segment(off, g.rows) = nd.comp[f.comp - 1].rhs;
+      else if (g.kind == Segment::Block)
+        r.segment(off, g.rows) = ws.blocks[g.id].rhs;
+      else
+        r.segment(off, g.rows) = ws.nodes[g.id].kpass;
+      off += g.rows;
+    }
+    r.array() *= cp.E.array();
+    const BufVec t = cp.Q.transpose() * r;
+    BufVec lam = cp.Q.rightCols(cp.nrows - cp.rank) * t.tail(cp.nrows - cp.rank);
+    lam.array() *= cp.E.array();
+    distribute(ws, nd, f.comp, lam, cert);
+    if (f.comp > 0) unrollNode(ws, i, f.comp - 1, cert);
+  } else {
+    const Vec6 xa = data.liMi[i].actInv(ws.a_world);
+    nd.nu = nd.kpass - nd.Kpass * xa;
+    nd.comp[nd.ncomp - 1].mu = nd.U2 * nd.nu;
+    unrollNode(ws, i, nd.ncomp - 1, cert);
+  }
+  for (int j = i + 1; j < model.nbodies; ++j) {
+    Node& c = ws.nodes[j];
+    if (!model.isAncestor(i, j) || c.ncomp == 0 || c.npass == 0) continue;
+    c.comp[c.ncomp - 1].mu = c.U2 * c.nu;
+    unrollNode(ws, j, c.ncomp - 1, cert);
+  }
+
+  const double big = cert.lpNorm<Eigen::Infinity>();
+  std::string names;
+  for (const TreeBlock& tb : ws.blocks) {
+    if (cert.segment(tb.global, tb.rows).lpNorm<Eigen::Infinity>() <= 1e-8 * big) continue;
+    if (!names.empty()) names += ", ";
+    names += "'" + ws.names[tb.constraint] + "'";
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3g", f.residual);
+  return "inconsistent constraints " + names + " (detected at body '" + model.body_names[i] +
+         "'" + (f.comp < 0 ? ", on rows no joint can move" : "") + "; residual " + buf +
+         "): no acceleration satisfies them all";
+}
+
+}  // namespace appell::detail

@@ -1,0 +1,170 @@
+// Private workspace of the tree solver (tree_solver.hpp): every per-body and
+// per-row quantity of the passes, sized once by the constructor. All small
+// matrices have compile-time maximum sizes, so the passes never allocate.
+#pragma once
+
+#include <appell/tree_solver.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace appell::detail {
+
+// Row stacks: at most 6 rows after compression, at most 12 while stacking.
+using KRows = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
+using KVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+using BufRows = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 12, 6>;
+using BufVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 12, 1>;
+using BufMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12>;
+using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+
+/// One piece of a node's row stack: the output of the previous compression,
+/// one constraint's own rows, or one child's unresolved rows.
+struct Segment {
+  enum Kind { Previous, Block, Child } kind = Previous;
+  int id = -1;    ///< block index (into TreeWorkspace::blocks) or child body
+  int rows = 0;
+};
+
+/// One rank-revealing compression  Qᵀ E [stacked rows] = [K; ≈0].
+struct Compression {
+  int nrows = 0;               ///< rows stacked
+  int rank = 0;                ///< rows kept
+  BufMat Q;                    ///< nrows × nrows orthogonal factor
+  BufVec E;                    ///< row equilibration scales
+  int nseg = 0;
+  std::array<Segment, 13> seg;
+  KVec rhs;                    ///< kept right sides (bias pass)
+  KVec mu;                     ///< multipliers of the kept rows (forward pass)
+};
+
+/// A constraint whose rows act on one body of the tree.
+struct TreeBlock {
+  int constraint = -1;         ///< index in the ConstraintList / ConstraintData
+  int body = -1;
+  double sign = 1;             ///< +1: rows Wₐ on bodyA; −1: rows −W_b on bodyB
+  int rows = 0;
+  int global = -1;             ///< first row in ConstraintData
+  KRows Kbody;                 ///< rows in the body frame (factor pass)
+  KVec rhs;                    ///< right side on the gravity-shifted acceleration
+};
+
+/// A row closing a loop: two moving bodies, or given over v (joint space).
+struct LoopRow {
+  int constraint = -1;
+  int row = -1;                ///< row within the constraint
+  int global = -1;             ///< row in ConstraintData
+  bool joint_space = false;
+  int bodyA = -1, bodyB = -1;
+};
+
+struct Node {
+  std::vector<Segment> groups;            ///< own blocks, then children
+  std::vector<Compression> comp;          ///< sized groups.size()
+  int ncomp = 0;
+
+  // Factor pass (depends on q and the rows only).
+  Mat6 IA;                                ///< articulated inertia before the joint
+  int nK = 0;                             ///< compressed rows at this body
+  KRows K;                                ///< compressed rows, body frame
+  int rankG = 0;                          ///< rows the joint resolves
+  int npass = 0, nf = 0;                  ///< rows handed up; free joint directions
+  SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK
+  SmallMat U2;                            ///< nK × npass, left null space of K S
+  SmallMat V2;                            ///< nv × nf, right null space of K S
+  KRows Kpass;                            ///< U2ᵀ K, this body's frame
+  KRows KpassParent;                      ///< the same covectors in the parent's frame
+  Mat6 P;                                 ///< 1 − S G⁺ K
+  Mat6X S2, U;                            ///< S V2 and IA S V2
+  SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
+  Mat6 Ia;                                ///< IA − U D⁻¹ Uᵀ
+  Mat6 H;                                 ///< Pᵀ Ia P: what the parent sees
+
+  // Bias pass (depends on the right sides).
+  Vec6 bias0;                             ///< initial bias force (v ×* I v, or unit forces)
+  Vec6 pA;                                ///< articulated bias before the joint
+  Vec6 c;                                 ///< velocity-product acceleration v × S q̇
+  KVec k;                                 ///< right sides of K
+  KVec kpass;                             ///< right sides of the handed-up rows (on a_parent)
+  KVec u;                                 ///< V2ᵀ τ − S2ᵀ pA
+
+  // Forward pass.
+  Vec6 a;                                 ///< acceleration (gravity-shifted)
+  KVec mu;                                ///< multipliers of K
+  KVec nu;                                ///< multipliers of the handed-up rows
+};
+
+struct Failure {
+  bool failed = false;
+  int node = -1;                          ///< body where rows turned out inconsistent
+  int comp = -1;                          ///< compression index, −1: at the world
+  double residual = 0;
+};
+
+struct TreeWorkspace {
+  SolverOptions options;
+  int nbodies = 0, nv = 0, m = 0;
+  std::vector<Node> nodes;
+  std::vector<TreeBlock> blocks;
+  std::vector<LoopRow> loops;
+  std::vector<std::string> names;         ///< constraint names, for messages
+
+  // Solver scratch with compile-time maximum sizes.
+  Eigen::ColPivHouseholderQR<BufRows> qr;
+  Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
+  BufRows buf;
+  BufVec bufE;
+
+  // Right sides of one pass.
+  VecX tau;                               ///< generalized force of the pass
+  Vec6 a_world;                           ///< world acceleration (world frame)
+  bool use_c = true;
+
+  // Outputs of one pass.
+  VecX vdot, lambda;
+  int redundant = 0;
+  Failure failure;
+
+  // Loop closure: k unit solves and the Schur complement.
+  MatX W;                                 ///< nv × k, response to each loop row's force
+  MatX L;                                 ///< m × k, tree multipliers of each response
+  MatX schur;                             ///< k × k
+  Eigen::JacobiSVD<MatX> schur_svd;
+  VecX vdot0, lambda0, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp;
+  std::vector<Vec6> a0;                   ///< body accelerations of the main pass
+  std::vector<Vec6> fsub;                 ///< subtree constraint forces (world frame)
+  int loop_rank = 0;
+
+  std::string last_error;
+};
+
+// Passes (tree_solver_backward.cpp, tree_solver_forward.cpp, tree_solver_loops.cpp).
+void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
+                TreeWorkspace& ws);
+/// Right-side pass; with `check`, returns false (ws.failure) on inconsistent rows.
+bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check);
+/// Accelerations and multipliers (ws.vdot, ws.lambda for tree rows); with
+/// `check`, tests the rows handed to the world and returns false on a mismatch.
+bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check);
+/// Multipliers of the stacked rows of compressions `from` … 0 of `body`
+/// (comp[from].mu set): λ_stack = E Q₁ μ, the adjoint of the compression,
+/// written to the body's own rows in `lambda` and to its children's `nu`.
+void unrollNode(TreeWorkspace& ws, int body, int from, VecX& lambda);
+/// Aᵀλ in O(n + m): row forces summed as world spatial forces over each
+/// subtree, projected on each joint's motion subspace.
+void reactionForces(const Model& model, const Data& data, const ConstraintData& cdata,
+                    TreeWorkspace& ws, const VecX& lambda, VecX& reaction);
+/// Solves the loop rows on top of the main pass (ws.vdot, ws.lambda, body
+/// accelerations), for the dynamics or, with `impulse`, the velocity
+/// projection. Returns false (ws.failure, ws.last_error) when inconsistent.
+bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdata,
+                TreeWorkspace& ws, const VecX& v, bool impulse);
+/// "…" message naming the constraints involved in the inconsistency of ws.failure.
+std::string describeFailure(const Model& model, const Data& data, TreeWorkspace& ws);
+
+}  // namespace appell::detail

@@ -1,0 +1,255 @@
+// The O(n) tree solver against the dense Udwadia–Kalaba reference
+// (test_tree_solver_common.hpp; the dense KKT solver: test_tree_solver_kkt.cpp):
+// v̇ to 1e-10 relative and Aᵀλ always, λ where A has full row rank — on random trees with every joint type, fixed and
+// floating base, 1–6 rows per body, duplicated and scaled rows, rows a joint
+// cannot move, and singular poses; inconsistent rows give an error naming them.
+#include "test_tree_solver_common.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace appell;
+using namespace appell::test;
+
+namespace {
+
+struct Compared {
+  double vdot = 0, reaction = 0, lambda = 0, constraint = 0;
+  bool full_rank = false;
+  int rank = 0, ref_rank = 0;
+};
+
+Compared compare(const System& s, const SolverOptions& opt = {}) {
+  const ConstraintList list = s.list();
+  Data data(s.model);
+  ConstraintData cd(s.model, list);
+  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  const Reference ref = denseReference(s.model, cd, s.q, s.v, s.tau);
+  TreeSolver solver(s.model, list, opt);
+  ConstrainedResult out;
+  solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+  EXPECT_TRUE(out.ok) << out.error;
+  Compared c;
+  c.vdot = relErr(out.vdot, ref.vdot);
+  c.reaction = relErr(out.reaction, ref.reaction);
+  if (cd.m > 0) {
+    c.reaction = std::max(c.reaction, relErr(cd.A.transpose() * out.lambda, ref.reaction));
+    c.constraint = (cd.A * out.vdot + cd.abias).lpNorm<Eigen::Infinity>() /
+                   std::max(1.0, cd.abias.lpNorm<Eigen::Infinity>());
+  }
+  c.full_rank = ref.rank == cd.m;
+  if (c.full_rank) c.lambda = relErr(out.lambda, ref.lambda);
+  c.rank = out.rank;
+  c.ref_rank = ref.rank;
+  return c;
+}
+
+}  // namespace
+
+TEST(TreeSolver, MatchesDenseReferenceOnRandomTrees) {
+  std::mt19937 rng(11);
+  int cases = 0, full = 0;
+  for (int n : {1, 2, 3, 5, 8, 13, 21, 34, 50}) {
+    for (bool floating : {false, true}) {
+      for (int rep = 0; rep < 6; ++rep) {
+        const System s = randomSystem(n, floating, rng, RowRecipe{});
+        const Compared c = compare(s);
+        ++cases;
+        full += c.full_rank;
+        EXPECT_LT(c.vdot, 1e-10) << "n=" << n << " floating=" << floating << " rep=" << rep;
+        EXPECT_LT(c.reaction, 1e-10) << "n=" << n << " floating=" << floating;
+        EXPECT_LT(c.constraint, 1e-9) << "n=" << n << " floating=" << floating;
+        EXPECT_EQ(c.rank, c.ref_rank) << "n=" << n << " floating=" << floating;
+        if (c.full_rank) {
+          EXPECT_LT(c.lambda, 1e-8) << "n=" << n << " floating=" << floating;
+        }
+      }
+    }
+  }
+  // The sample must exercise both regimes.
+  EXPECT_GT(full, 5);
+  EXPECT_LT(full, cases);
+}
+
+TEST(TreeSolver, DuplicatedScaledAndImmobileRows) {
+  std::mt19937 rng(12);
+  const RowRecipe recipe{0.35, 0.35, 3};
+  for (int n : {1, 2, 4, 9, 20, 40}) {
+    for (bool floating : {false, true}) {
+      for (int rep = 0; rep < 4; ++rep) {
+        const System s = randomSystem(n, floating, rng, recipe);
+        const Compared c = compare(s);
+        EXPECT_LT(c.vdot, 1e-10) << "n=" << n << " floating=" << floating << " rep=" << rep;
+        EXPECT_LT(c.reaction, 1e-10) << "n=" << n << " floating=" << floating;
+        EXPECT_EQ(c.rank, c.ref_rank) << "n=" << n << " floating=" << floating;
+        if (c.full_rank) {
+          EXPECT_LT(c.lambda, 1e-8);
+        }
+      }
+    }
+  }
+}
+
+TEST(TreeSolver, FewRowsLeaveMostJointsAsPlainAba) {
+  // One row on one leaf: the solver must equal ABA + one rank-one correction,
+  // and with no rows at all it must equal ABA to round-off.
+  std::mt19937 rng(13);
+  for (bool floating : {false, true}) {
+    System s;
+    s.model = randomTree(30, floating, rng);
+    s.q = randomConfiguration(s.model, rng);
+    s.v = randomVector(s.model.nv, rng);
+    s.tau = randomVector(s.model.nv, rng);
+    Data data(s.model);
+    const VecX ddq = aba(s.model, data, s.q, s.v, s.tau);
+    ConstraintList none;
+    ConstraintData cd(s.model, none);
+    evaluateConstraints(s.model, data, none, cd, 0.0, s.q, s.v);
+    TreeSolver solver(s.model, none);
+    ConstrainedResult out;
+    solver.solve(s.model, data, none, cd, s.q, s.v, s.tau, out);
+    ASSERT_TRUE(out.ok);
+    EXPECT_LT(relErr(out.vdot, ddq), 1e-12);
+
+    Rows K(1, 6);
+    K.row(0) = randomRow(rng).transpose();
+    s.local.push_back(std::make_shared<LocalRows>("leaf", s.model.nbodies - 1, K));
+    makeConsistent(s, rng);
+    const Compared c = compare(s);
+    EXPECT_LT(c.vdot, 1e-10);
+    EXPECT_LT(c.reaction, 1e-10);
+  }
+}
+
+TEST(TreeSolver, SingularPoseOfAStretchedArm) {
+  // Planar two-link arm along x at q = 0: its tip cannot accelerate along the
+  // arm by joint accelerations (a singular pose). A row along x at the tip is
+  // an all-zero row of A once the velocity term is accounted for: redundant
+  // when consistent, an error naming it otherwise. The row along y resolves.
+  ModelBuilder b;
+  const Inertia rod{1.0, Vec3(0.5, 0, 0), Vec3(0.01, 0.1, 0.1).asDiagonal()};
+  b.addBody("link1", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitZ(), rod);
+  SE3 X;
+  X.p = Vec3(1, 0, 0);
+  const int l2 = b.addBody("link2", 0, X, JointType::Revolute, Vec3::UnitZ(), rod);
+  System s;
+  s.model = b.build();
+  s.q = VecX::Zero(2);
+  s.v = VecX::Zero(2);
+  s.tau = Eigen::Vector2d(0.3, -0.2);
+  const Vec3 tip(1, 0, 0);
+  Rows K(2, 6);
+  K.row(0) << tip.cross(Vec3::UnitX()).transpose(), Vec3::UnitX().transpose();
+  K.row(1) << tip.cross(Vec3::UnitY()).transpose(), Vec3::UnitY().transpose();
+  s.local.push_back(std::make_shared<LocalRows>("tip", l2, K));
+  std::mt19937 rng(14);
+  makeConsistent(s, rng);
+  const Compared c = compare(s);
+  EXPECT_LT(c.vdot, 1e-12);
+  EXPECT_LT(c.reaction, 1e-12);
+  EXPECT_EQ(c.rank, 1);
+
+  // Same pose, an inconsistent right side on the immobile row.
+  s.local[0]->kappa()[0] += 0.5;
+  const ConstraintList list = s.list();
+  Data data(s.model);
+  ConstraintData cd(s.model, list);
+  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  TreeSolver solver(s.model, list);
+  ConstrainedResult out;
+  solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+  EXPECT_FALSE(out.ok);
+  EXPECT_NE(out.error.find("'tip'"), std::string::npos) << out.error;
+}
+
+TEST(TreeSolver, InconsistentDuplicateIsAnErrorNamingTheConstraints) {
+  std::mt19937 rng(15);
+  for (bool floating : {false, true}) {
+    System s;
+    s.model = randomTree(12, floating, rng);
+    s.q = randomConfiguration(s.model, rng);
+    s.v = randomVector(s.model.nv, rng);
+    s.tau = randomVector(s.model.nv, rng);
+    // A row on body 7 and the same row, scaled, in a second constraint there;
+    // an unrelated constraint on body 3.
+    Rows K1(2, 6), K2(1, 6), K3(1, 6);
+    K1.row(0) = randomRow(rng).transpose();
+    K1.row(1) = randomRow(rng).transpose();
+    K2.row(0) = -2.5 * K1.row(1);
+    K3.row(0) = randomRow(rng).transpose();
+    s.local.push_back(std::make_shared<LocalRows>("first", 7, K1));
+    s.local.push_back(std::make_shared<LocalRows>("second", 7, K2));
+    s.local.push_back(std::make_shared<LocalRows>("bystander", 3, K3));
+    makeConsistent(s, rng);
+    // Consistent: fine, with one redundant row.
+    const Compared c = compare(s);
+    EXPECT_LT(c.vdot, 1e-10);
+    EXPECT_EQ(c.rank, 3);
+    // Now break the duplicate's right side.
+    s.local[1]->kappa()[0] += 1e-3;
+    const ConstraintList list = s.list();
+    Data data(s.model);
+    ConstraintData cd(s.model, list);
+    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+    TreeSolver solver(s.model, list);
+    ConstrainedResult out;
+    solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+    EXPECT_FALSE(out.ok);
+    EXPECT_NE(out.error.find("'first'"), std::string::npos) << out.error;
+    EXPECT_NE(out.error.find("'second'"), std::string::npos) << out.error;
+    EXPECT_EQ(out.error.find("'bystander'"), std::string::npos) << out.error;
+  }
+}
+
+TEST(TreeSolver, InconsistentRowsSpreadOverATree) {
+  // Rows on a fixed-base chain: a row on the last body repeated, through the
+  // chain's fixed joints, on its parent — the inconsistency is found where the
+  // rows meet, and both constraints are named.
+  ModelBuilder b;
+  std::mt19937 rng(16);
+  b.addBody("base", -1, randomPlacement(rng), JointType::Revolute, randomUnit(rng),
+            randomInertia(rng));
+  b.addBody("plate", 0, randomPlacement(rng), JointType::Fixed, Vec3::UnitZ(), randomInertia(rng));
+  b.addBody("tool", 1, randomPlacement(rng), JointType::Fixed, Vec3::UnitZ(), randomInertia(rng));
+  System s;
+  s.model = b.build();
+  s.q = randomConfiguration(s.model, rng);
+  s.v = randomVector(s.model.nv, rng);
+  s.tau = randomVector(s.model.nv, rng);
+  Data data(s.model);
+  forwardKinematics(s.model, data, s.q);
+  // The same world covector seen from "tool" and from "plate".
+  const Vec6 w_world = randomRow(rng);
+  Rows Kt(1, 6), Kp(1, 6);
+  Kt.row(0) = data.oMi[2].actInvForce(w_world).transpose();
+  Kp.row(0) = 3.0 * data.oMi[1].actInvForce(w_world).transpose();
+  s.local.push_back(std::make_shared<LocalRows>("on_tool", 2, Kt));
+  s.local.push_back(std::make_shared<LocalRows>("on_plate", 1, Kp));
+  makeConsistent(s, rng);
+  EXPECT_LT(compare(s).vdot, 1e-11);
+  s.local[0]->kappa()[0] += 0.1;
+  const ConstraintList list = s.list();
+  ConstraintData cd(s.model, list);
+  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  TreeSolver solver(s.model, list);
+  ConstrainedResult out;
+  solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+  EXPECT_FALSE(out.ok);
+  EXPECT_NE(out.error.find("'on_tool'"), std::string::npos) << out.error;
+  EXPECT_NE(out.error.find("'on_plate'"), std::string::npos) << out.error;
+}
+
+TEST(TreeSolver, RejectsBadConstraints) {
+  std::mt19937 rng(18);
+  const Model model = randomTree(4, false, rng);
+  Rows K(1, 6);
+  K.row(0) = randomRow(rng).transpose();
+  ConstraintList out_of_range{std::make_shared<LocalRows>("far", 9, K)};
+  try {
+    TreeSolver s(model, out_of_range);
+    FAIL() << "expected an exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'far'"), std::string::npos);
+  }
+  ConstraintList nobody{std::make_shared<LocalRows>("ghost", -1, K)};
+  EXPECT_THROW(TreeSolver(model, nobody), std::invalid_argument);
+}

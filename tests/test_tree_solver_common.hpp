@@ -1,0 +1,231 @@
+// Shared pieces of the tree-solver tests: test-only constraints with random
+// body-local rows, consistent right sides, and the dense Udwadia–Kalaba
+// reference (REFERENCES.md):
+//   v̇ = a + M^{-½}(A M^{-½})⁺(c − A a),  a = M⁻¹(τ − h),  c = −abias,
+//   λ_min = (Aᵀ)⁺(M v̇ + h − τ).
+#pragma once
+
+#include <appell/appell.hpp>
+#include <appell/kkt.hpp>
+#include <appell/tree_solver.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+
+#include <memory>
+#include <random>
+#include <string>
+
+#include "random_tree.hpp"
+
+namespace appell::test {
+
+using Rows = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
+
+/// Rows given as covectors in the frames of body A (and body B), constant there.
+class LocalRows : public Constraint {
+ public:
+  LocalRows(std::string name, int a, const Rows& Ka, int b = -1, const Rows& Kb = Rows())
+      : name_(std::move(name)), a_(a), b_(b), Ka_(Ka), Kb_(Kb),
+        kappa_(VecX::Zero(Ka.rows())), bvel_(VecX::Zero(Ka.rows())) {}
+  const std::string& name() const override { return name_; }
+  int rows() const override { return static_cast<int>(Ka_.rows()); }
+  int bodyA() const override { return a_; }
+  int bodyB() const override { return b_; }
+  std::string rowLabel(int k) const override { return "row" + std::to_string(k); }
+  bool holonomic(int) const override { return false; }
+  void evaluate(const Model&, const Data& data, double, const VecX&, const VecX&,
+                RowBlock& out) const override {
+    const int m = rows();
+    for (int r = 0; r < m; ++r) {
+      // A body covector w_b is the world covector w with w·V = w_b·V_b: w = ᵒX_b⁻ᵀ w_b.
+      const Vec6 wa = a_ >= 0 ? data.oMi[a_].actForce(Ka_.row(r).transpose()) : Vec6::Zero();
+      const Vec6 wb = b_ >= 0 ? data.oMi[b_].actForce(Kb_.row(r).transpose()) : Vec6::Zero();
+      out.Wa.row(r) = wa.transpose();
+      out.Wb.row(r) = wb.transpose();
+      out.kappa[r] = kappa_[r];
+      out.b[r] = bvel_[r];
+      out.gap[r] = 0;
+    }
+  }
+  VecX& kappa() { return kappa_; }
+  VecX& bvel() { return bvel_; }
+
+ private:
+  std::string name_;
+  int a_, b_;
+  Rows Ka_, Kb_;
+  VecX kappa_, bvel_;
+};
+
+/// Rows over the generalized velocities.
+class JointRows : public Constraint {
+ public:
+  JointRows(std::string name, const MatX& A)
+      : name_(std::move(name)), A_(A), abias_(VecX::Zero(A.rows())), b_(VecX::Zero(A.rows())) {}
+  const std::string& name() const override { return name_; }
+  int rows() const override { return static_cast<int>(A_.rows()); }
+  int bodyA() const override { return -1; }
+  bool jointSpace() const override { return true; }
+  std::string rowLabel(int k) const override { return "joint" + std::to_string(k); }
+  bool holonomic(int) const override { return false; }
+  void evaluate(const Model&, const Data&, double, const VecX&, const VecX&,
+                RowBlock& out) const override {
+    out.A_joint = A_;
+    out.abias_joint = abias_;
+    out.b_joint = b_;
+  }
+  VecX& abias() { return abias_; }
+  VecX& bvel() { return b_; }
+
+ private:
+  std::string name_;
+  MatX A_;
+  VecX abias_, b_;
+};
+
+/// A system under test: model, state, constraints (kept mutable for their right sides).
+struct System {
+  Model model;
+  VecX q, v, tau;
+  std::vector<std::shared_ptr<LocalRows>> local;
+  std::vector<std::shared_ptr<JointRows>> joint;
+  ConstraintList list() const {
+    ConstraintList l;
+    for (auto& c : local) l.push_back(c);
+    for (auto& c : joint) l.push_back(c);
+    return l;
+  }
+};
+
+/// Sets κ and b so that a random v̇* and v* satisfy every row: A v̇* + abias = 0,
+/// A v* + b = 0. Redundant rows are then consistent by construction.
+inline void makeConsistent(System& s, std::mt19937& rng) {
+  const ConstraintList list = s.list();
+  Data data(s.model);
+  ConstraintData cd(s.model, list);
+  for (auto& c : s.local) c->kappa().setZero(), c->bvel().setZero();
+  for (auto& c : s.joint) c->abias().setZero(), c->bvel().setZero();
+  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  const VecX vd = randomVector(s.model.nv, rng), vs = randomVector(s.model.nv, rng);
+  const VecX Avd = cd.A * vd + cd.abias, Avs = cd.A * vs;
+  int o = 0;
+  for (auto& c : s.local) {
+    c->kappa() = -Avd.segment(o, c->rows());
+    c->bvel() = -Avs.segment(o, c->rows());
+    o += c->rows();
+  }
+  for (auto& c : s.joint) {
+    c->abias() = -Avd.segment(o, c->rows());
+    c->bvel() = -Avs.segment(o, c->rows());
+    o += c->rows();
+  }
+}
+
+/// Pseudo-inverse solve with a relative singular-value threshold.
+inline VecX pinvSolve(const MatX& A, const VecX& b, double rel = 1e-10) {
+  Eigen::JacobiSVD<MatX> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  svd.setThreshold(rel);
+  return svd.solve(b);
+}
+
+struct Reference {
+  VecX vdot, lambda, reaction;
+  int rank = 0;
+};
+
+/// Udwadia–Kalaba with the symmetric square root of M.
+inline Reference denseReference(const Model& model, const ConstraintData& cd, const VecX& q,
+                                const VecX& v, const VecX& tau) {
+  Data data(model);
+  const MatX M = crba(model, data, q);
+  const VecX h = nonLinearEffects(model, data, q, v);
+  Eigen::SelfAdjointEigenSolver<MatX> es(M);
+  const MatX Mih = es.operatorInverseSqrt();
+  const VecX a = M.ldlt().solve(tau - h);
+  Reference r;
+  if (cd.m == 0) {
+    r.vdot = a;
+    r.lambda = VecX::Zero(0);
+    r.reaction = VecX::Zero(model.nv);
+    return r;
+  }
+  const MatX B = cd.A * Mih;
+  r.vdot = a + Mih * pinvSolve(B, -cd.abias - cd.A * a);
+  r.reaction = M * r.vdot + h - tau;
+  r.lambda = pinvSolve(cd.A.transpose(), r.reaction);
+  Eigen::JacobiSVD<MatX> svd(cd.A);
+  svd.setThreshold(1e-10);
+  r.rank = static_cast<int>(svd.rank());
+  return r;
+}
+
+/// Dense M-metric projection v⁺ = v + M^{-½}(A M^{-½})⁺(−b − A v).
+inline VecX denseProjection(const Model& model, const ConstraintData& cd, const VecX& q,
+                            const VecX& v) {
+  Data data(model);
+  const MatX M = crba(model, data, q);
+  Eigen::SelfAdjointEigenSolver<MatX> es(M);
+  const MatX Mih = es.operatorInverseSqrt();
+  return v + Mih * pinvSolve(cd.A * Mih, -cd.b - cd.A * v);
+}
+
+struct RowRecipe {
+  double p_duplicate = 0.0;   ///< row = scale × an earlier row of the same body
+  double p_immobile = 0.0;    ///< row orthogonal to the body's own joint subspace
+  int max_constraints = 2;    ///< per body
+};
+
+inline Vec6 randomRow(std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> e(-1.5, 1.5);
+  Vec6 w;
+  for (int k = 0; k < 6; ++k) w[k] = g(rng);
+  return std::pow(10.0, e(rng)) * w.normalized();
+}
+
+/// Random body-local rows on every body (some bodies get none).
+inline void addRandomRows(System& s, std::mt19937& rng, const RowRecipe& recipe) {
+  std::uniform_real_distribution<double> u(0, 1), sc(-3, 3);
+  std::uniform_int_distribution<int> nrows(1, 6), ncons(0, recipe.max_constraints);
+  for (int i = 0; i < s.model.nbodies; ++i) {
+    std::vector<Vec6> earlier;
+    const int nc = ncons(rng);
+    for (int c = 0; c < nc; ++c) {
+      const int m = nrows(rng);
+      Rows K(m, 6);
+      for (int r = 0; r < m; ++r) {
+        Vec6 w = randomRow(rng);
+        const Mat6X& S = s.model.joints[i].S;
+        if (!earlier.empty() && u(rng) < recipe.p_duplicate) {
+          w = sc(rng) * earlier[std::uniform_int_distribution<size_t>(0, earlier.size() - 1)(rng)];
+          if (w.norm() == 0) w = randomRow(rng);
+        } else if (S.cols() > 0 && S.cols() < 6 && u(rng) < recipe.p_immobile) {
+          // w·S = 0: the body's own joint cannot move this row.
+          w -= S * (S.transpose() * S).ldlt().solve(S.transpose() * w);
+        }
+        K.row(r) = w.transpose();
+        earlier.push_back(w);
+      }
+      s.local.push_back(std::make_shared<LocalRows>(
+          "rows" + std::to_string(s.local.size()) + "@body" + std::to_string(i), i, K));
+    }
+  }
+}
+
+inline System randomSystem(int n, bool floating, std::mt19937& rng, const RowRecipe& recipe) {
+  System s;
+  s.model = randomTree(n, floating, rng);
+  s.q = randomConfiguration(s.model, rng);
+  s.v = randomVector(s.model.nv, rng, 1.5);
+  s.tau = randomVector(s.model.nv, rng, 2.0);
+  addRandomRows(s, rng, recipe);
+  makeConsistent(s, rng);
+  return s;
+}
+
+inline double relErr(const VecX& a, const VecX& b) {
+  return (a - b).norm() / std::max(1.0, b.norm());
+}
+
+}  // namespace appell::test
