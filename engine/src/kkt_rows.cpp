@@ -9,7 +9,7 @@ namespace appell::detail {
 RowBasis::RowBasis(int n, int m)
     : n_(n), m_(m), k_(std::min(n, m)), D_(VecX::Zero(m)), Be_(MatX::Zero(n, m)),
       qr_(n, m), Q_(MatX::Identity(n, n)), work_n_(VecX::Zero(n)), work_m_(VecX::Zero(m)),
-      pd_(VecX::Zero(m)), z_(VecX::Zero(n)), E_(MatX::Zero(m, m)), eqr_(m, m),
+      pd_(VecX::Zero(m)), z_(VecX::Zero(n)), E_(MatX::Zero(m, m)), eqr_(m, m), Qe_(MatX::Identity(m, m)),
       w_(VecX::Zero(m)) {}
 
 void RowBasis::factor(const MatX& B, const SolverOptions& options) {
@@ -88,7 +88,11 @@ void RowBasis::minNorm(const MatX& B, const VecX& y, VecX& lambda) {
   range_residual_ = 0;
   if (m_ == 0) return;
   // Part of y outside range(B): ‖Q₂ᵀ y‖.
-  if (rank_ < n_) range_residual_ = (Q2().transpose() * y).norm();
+  if (rank_ < n_) {
+    auto outside = work_n_.head(n_ - rank_);
+    outside.noalias() = Q2().transpose() * y;
+    range_residual_ = outside.norm();
+  }
   if (rank_ == 0) return;
   auto s = w_.head(rank_);
   s.noalias() = Q1().transpose() * y;
@@ -98,9 +102,8 @@ void RowBasis::minNorm(const MatX& B, const VecX& y, VecX& lambda) {
   E_.leftCols(rank_).noalias() = B.transpose() * Q1();
   eqr_.compute(E_);
   eqr_.matrixQR().topLeftCorner(rank_, rank_).triangularView<Eigen::Upper>().transpose().solveInPlace(s);
-  lambda.head(rank_) = s;
-  Eigen::Matrix<double, 1, 1> ws;
-  eqr_.householderQ().applyThisOnTheLeft(lambda, ws);
+  eqr_.householderQ().evalTo(Qe_, work_m_);
+  lambda.noalias() = Qe_.leftCols(rank_) * s;
 }
 
 std::string rowName(const ConstraintList& constraints, const ConstraintData& cdata, int i) {

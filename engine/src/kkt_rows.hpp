@@ -80,6 +80,7 @@ class RowBasis {
   // Minimum-norm multipliers.
   MatX E_;                  // m × m
   Eigen::HouseholderQR<MatX> eqr_;
+  MatX Qe_;                 // m × m
   VecX w_;                  // m
   double range_residual_ = 0;
   // Last inconsistency: pivot position of the worst dropped row (−1: a zero row

@@ -84,6 +84,7 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   v_prev_ = v_;
   tau_ = VecX::Zero(model_.nv);
   impulse_ = VecX::Zero(cdata_->m);
+  row_buf_ = VecX::Zero(cdata_->m);
   result_.vdot = VecX::Zero(model_.nv);
   result_.lambda = VecX::Zero(cdata_->m);
   result_.reaction = VecX::Zero(model_.nv);
@@ -148,7 +149,14 @@ StepStatus Simulator::fail(StepStatus st, std::string message) {
 // asked, the dynamics (λ, contact forces) at (t, q, v).
 bool Simulator::evaluateEndState(std::string& error) {
   evaluateConstraints(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  velocity_residual_ = appell::velocityResidual(*cdata_, v_);
+  // ‖A v + b‖∞ into a preallocated buffer (appell::velocityResidual makes a temporary).
+  if (cdata_->m > 0) {
+    row_buf_.noalias() = cdata_->A * v_;
+    row_buf_ += cdata_->b;
+    velocity_residual_ = row_buf_.lpNorm<Eigen::Infinity>();
+  } else {
+    velocity_residual_ = 0;
+  }
   gap_residual_ = appell::gapResidual(*cdata_);
   bool ok = true;
   if (options_.evaluate_end_state) {

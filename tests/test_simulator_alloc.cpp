@@ -1,0 +1,140 @@
+// No heap allocation inside Simulator::step(): every solver (KKT, Appell with
+// both null spaces) with every integrator, on a system with holonomic and
+// nonholonomic rows, a second body and a joint-force callback. The global
+// operator new is replaced in this file and counts while armed.
+#include <appell/appell_maggi.hpp>
+#include <appell/kkt.hpp>
+#include <appell/simulator.hpp>
+
+#include "test_solver_rows.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+namespace {
+std::atomic<bool> g_armed{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+// Eigen allocates with std::malloc (its aligned_malloc), the standard library
+// with operator new, which ends in malloc too: interpose the C allocator
+// itself (glibc exports the real one as __libc_*).
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void __libc_free(void*);
+
+static void count() {
+  if (g_armed.load(std::memory_order_relaxed)) {
+    g_allocations.fetch_add(1);
+    if (std::getenv("APPELL_ALLOC_TRAP")) __builtin_trap();
+  }
+}
+void* malloc(std::size_t n) {
+  count();
+  return __libc_malloc(n);
+}
+void* calloc(std::size_t k, std::size_t n) {
+  count();
+  return __libc_calloc(k, n);
+}
+void* realloc(void* p, std::size_t n) {
+  count();
+  return __libc_realloc(p, n);
+}
+void* memalign(std::size_t a, std::size_t n) {
+  count();
+  return __libc_memalign(a, n);
+}
+void* aligned_alloc(std::size_t a, std::size_t n) {
+  count();
+  return __libc_memalign(a, n);
+}
+int posix_memalign(void** out, std::size_t a, std::size_t n) {
+  count();
+  *out = __libc_memalign(a, n);
+  return *out ? 0 : 12;  // ENOMEM
+}
+void free(void* p) { __libc_free(p); }
+}
+
+namespace appell {
+namespace {
+
+struct Arm {
+  Arm() {
+    g_allocations = 0;
+    g_armed = true;
+  }
+  ~Arm() { g_armed = false; }
+};
+
+Model ballWithPendulum() {
+  ModelBuilder b;
+  b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+            Inertia{2.0, Vec3(0.01, -0.02, 0.03), Vec3(0.05, 0.06, 0.07).asDiagonal()}, "free");
+  SE3 X;
+  X.p = Vec3(0, 0, 0.1);
+  b.addBody("bob", 0, X, JointType::Revolute, Vec3(1, 1, 0).normalized(),
+            Inertia{0.5, Vec3(0, 0, -0.2), Vec3(0.01, 0.01, 0.002).asDiagonal()}, "hinge");
+  return b.build();
+}
+
+TEST(SimulatorAllocation, StepDoesNotAllocate) {
+  const Model model = ballWithPendulum();
+  const double R = 0.3;
+  // Rolling rows + a redundant copy of the no-slip rows (rank handling on the hot path).
+  ConstraintList c{std::make_shared<test::RollingBall>("contact", 0, R),
+                   std::make_shared<test::BodyRows>(
+                       "extra", 0, std::vector<Vec6>{test::pointRow(Vec3(0, 0, 0.5), Vec3::UnitX())})};
+  VecX q = neutralConfiguration(model);
+  q[2] = R;
+  VecX v = VecX::Zero(model.nv);
+  v.head<3>() = Vec3(0.5, -1.0, 2.0);
+  v.segment<3>(3) = Vec3(0.5, -1.0, 2.0).cross(Vec3(0, 0, R));
+  v[6] = 1.0;
+  for (int which = 0; which < 3; ++which) {
+    for (IntegratorType it : {IntegratorType::SymplecticEuler, IntegratorType::RK4,
+                              IntegratorType::DormandPrince54}) {
+      std::unique_ptr<ConstrainedSolver> solver;
+      if (which == 0) solver = std::make_unique<KktSolver>(model, c);
+      if (which == 1) solver = std::make_unique<AppellSolver>(model, c);
+      if (which == 2)
+        solver = std::make_unique<AppellSolver>(model, c, SolverOptions{},
+                                                AppellOptions{NullSpace::CoordinatePartition});
+      Simulator sim(model, c, std::move(solver), it);
+      sim.setJointForces([](double t, const VecX&, const VecX&, VecX& tau) {
+        tau[6] = 0.1 * std::sin(t);  // a hinge motor
+      });
+      sim.setState(0, q, v);
+      ASSERT_TRUE(sim.projectState().ok);
+      long allocations = 0;
+      for (int k = 0; k < 50; ++k) {
+        StepStatus st;
+        {
+          Arm arm;
+          st = sim.step(1e-3);
+          allocations += g_allocations;
+        }
+        ASSERT_TRUE(st.ok) << st.message;
+      }
+      EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
+      EXPECT_LT(sim.velocityResidual(), 1e-10);
+    }
+  }
+}
+
+// The counter works: a step that fails (and builds its message) does allocate.
+TEST(SimulatorAllocation, CounterSeesAllocations) {
+  Arm arm;
+  auto p = std::make_unique<std::vector<double>>(100);
+  EXPECT_GT(g_allocations.load(), 0);
+}
+
+}  // namespace
+}  // namespace appell
