@@ -228,3 +228,58 @@ TEST(ContactPhysics, PassiveRollingConservesEnergyAndKeepsTheConstraints) {
     EXPECT_GT((q.head<3>() - pose.p).norm(), 1e-3) << pc.name;
   }
 }
+
+TEST(ContactPhysics, BallRollingOnAFreeCartConservesMomentumAndEnergy) {
+  // No gravity; a free cart carries the support, a ball rolls on it. The
+  // contact forces are internal: total momentum is conserved, and passive
+  // rolling does no work.
+  for (const SupportSurface& surf :
+       std::vector<SupportSurface>{Plane{Vec3(0, 0, 0.2), Vec3(0.1, 0.2, 1).normalized()},
+                                   SphereSurface{Vec3(0, 0, 1.0), 1.0,
+                                                 SphereSurface::Side::Inside}}) {
+    ModelBuilder mb;
+    mb.setGravity(Vec3::Zero());
+    mb.addBody("cart", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+               Inertia{4.0, Vec3(0.1, 0, 0), Vec3(0.5, 0.7, 0.9).asDiagonal()});
+    mb.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+               // Off-centre mass, unequal moments (a Chaplygin ball): rolling needs forces.
+               Inertia{1.0, Vec3(0.03, 0, 0), Vec3(0.3, 0.4, 0.5).asDiagonal() * 0.01});
+    const Model model = mb.build();
+    Support sup{surf, StaticMotion{}, "cart top"};
+    sup.body = 0;
+    const auto c = makeContact(ContactKind::Rolling, 1, Sphere{0.1, Vec3::Zero()}, sup);
+    Sim sim(model, {c});
+    // Cart at rest at the origin, then the ball put in contact with a rolling velocity.
+    SE3 cart, ball;
+    ball.p = Vec3(0.3, -0.2, 0.5);
+    ContactGeometry g;
+    const SupportState S = c->supportStateAt(0, cart);
+    for (int k = 0; k < 4; ++k) {
+      contactGeometry(c->shape(), surf, S, ball, Vec6::Zero(), g);
+      ball.p -= g.gap * g.normal;
+    }
+    contactGeometry(c->shape(), surf, S, ball, Vec6::Zero(), g);
+    const Vec3 w(1.0, 2.0, -0.5);
+    Vec6 Vb;
+    Vb << w, -w.cross(g.point);
+    VecX qc, vc, qb, vb;
+    floatingState(cart, Vec6::Zero(), qc, vc);
+    floatingState(ball, Vb, qb, vb);
+    VecX q(14), v(12);
+    q << qc, qb;
+    v << vc, vb;
+    double t = 0;
+    ASSERT_LT(sim.residuals(t, q, v).first, 1e-12);
+    const Vec6 P0 = momentum(model, sim.data, q, v);
+    const double E0 = sim.energy(q, v);
+    for (int k = 0; k < 2000; ++k) sim.step(t, q, v, 5e-4);
+    const Vec6 P1 = momentum(model, sim.data, q, v);
+    EXPECT_LT((P1 - P0).norm(), 1e-10 * (1 + P0.norm()));
+    EXPECT_NEAR(sim.energy(q, v), E0, 1e-9 * E0);
+    const auto [rv, rg] = sim.residuals(t, q, v);
+    EXPECT_LT(rv, 1e-8);
+    EXPECT_LT(rg, 1e-8);
+    // The cart was set moving by the ball.
+    EXPECT_GT(v.head<6>().norm(), 1e-2);
+  }
+}
