@@ -1,0 +1,154 @@
+// Failures inside a step are reported, never hidden: non-finite joint forces,
+// constraints that become contradictory, bad arguments. The last good state is
+// kept and stepping can resume once the cause is gone. Also: projecting an
+// initial state that violates the constraints.
+#include <appell/appell_maggi.hpp>
+#include <appell/kkt.hpp>
+#include <appell/simulator.hpp>
+
+#include "test_solver_rows.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+namespace appell {
+namespace {
+
+using test::RollingBall;
+
+// Two copies of one no-slip row; while *broken, the second asks for a
+// different acceleration (κ = 1): no motion satisfies both.
+class ContradictoryWhen final : public Constraint {
+ public:
+  explicit ContradictoryWhen(std::shared_ptr<bool> broken) : broken_(std::move(broken)) {}
+  const std::string& name() const override { return name_; }
+  int rows() const override { return 2; }
+  int bodyA() const override { return 0; }
+  std::string rowLabel(int k) const override { return k == 0 ? "first" : "second"; }
+  bool holonomic(int) const override { return false; }
+  void evaluate(const Model&, const Data& data, double, const VecX&, const VecX&,
+                RowBlock& out) const override {
+    const Vec6 w = data.oMi[0].actForce(test::pointRow(Vec3(0, 0, 0.3), Vec3::UnitY()));
+    out.Wa.row(0) = w.transpose();
+    out.Wa.row(1) = w.transpose();
+    out.kappa[0] = 0;
+    out.kappa[1] = *broken_ ? 1.0 : 0.0;
+    out.b.setZero();
+    out.gap.setZero();
+  }
+
+ private:
+  std::shared_ptr<bool> broken_;
+  std::string name_ = "twin_rows";
+};
+
+struct Ball {
+  Model model = test::ballModel(1.0, Vec3(0.02, 0.03, 0.04).asDiagonal(), Vec3(0.01, 0, 0.02));
+  double R = 0.3;
+  VecX q0, v0;
+  Ball() {
+    q0 = neutralConfiguration(model);
+    q0[2] = R;
+    const Vec3 w(0.3, 1.0, -0.5);
+    v0 = VecX(6);
+    v0 << w, w.cross(Vec3(0, 0, R));
+  }
+};
+
+void expectSameState(const Simulator& sim, double t, const VecX& q, const VecX& v) {
+  EXPECT_EQ(sim.time(), t);
+  EXPECT_EQ(sim.q(), q);
+  EXPECT_EQ(sim.v(), v);
+}
+
+TEST(SimulatorFailure, NonFiniteJointForcesKeepTheLastGoodState) {
+  const Ball b;
+  ConstraintList c{std::make_shared<RollingBall>("contact", 0, b.R)};
+  for (IntegratorType it : {IntegratorType::RK4, IntegratorType::DormandPrince54}) {
+    Simulator sim(b.model, c, std::make_unique<KktSolver>(b.model, c), it);
+    auto poison = std::make_shared<bool>(false);
+    sim.setJointForces([poison](double, const VecX&, const VecX&, VecX& tau) {
+      if (*poison) tau[0] = std::numeric_limits<double>::quiet_NaN();
+    });
+    sim.setState(0, b.q0, b.v0);
+    for (int k = 0; k < 10; ++k) ASSERT_TRUE(sim.step(1e-3).ok);
+    const double t = sim.time();
+    const VecX q = sim.q(), v = sim.v();
+    *poison = true;
+    const StepStatus st = sim.step(1e-3);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("joint-force callback"), std::string::npos) << st.message;
+    expectSameState(sim, t, q, v);
+    EXPECT_EQ(sim.counters().failed, 1);
+    EXPECT_EQ(sim.counters().steps, 10);
+    // The cause removed, stepping resumes from the kept state.
+    *poison = false;
+    EXPECT_TRUE(sim.step(1e-3).ok);
+    EXPECT_GT(sim.time(), t);
+  }
+}
+
+TEST(SimulatorFailure, ContradictoryConstraintsAreReportedByName) {
+  const Ball b;
+  auto broken = std::make_shared<bool>(false);
+  ConstraintList c{std::make_shared<RollingBall>("contact", 0, b.R),
+                   std::make_shared<ContradictoryWhen>(broken)};
+  for (int which = 0; which < 2; ++which) {
+    std::unique_ptr<ConstrainedSolver> solver;
+    if (which == 0) solver = std::make_unique<KktSolver>(b.model, c);
+    else solver = std::make_unique<AppellSolver>(b.model, c);
+    Simulator sim(b.model, c, std::move(solver), IntegratorType::RK4);
+    *broken = false;
+    sim.setState(0, b.q0, b.v0);
+    ASSERT_TRUE(sim.projectState().ok);
+    for (int k = 0; k < 5; ++k) ASSERT_TRUE(sim.step(1e-3).ok);
+    EXPECT_EQ(sim.redundantRows(), 1);  // the twin row is redundant while consistent
+    const double t = sim.time();
+    const VecX q = sim.q(), v = sim.v();
+    *broken = true;
+    const StepStatus st = sim.step(1e-3);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("inconsistent"), std::string::npos) << st.message;
+    EXPECT_NE(st.message.find("twin_rows"), std::string::npos) << st.message;
+    expectSameState(sim, t, q, v);
+  }
+}
+
+TEST(SimulatorFailure, BadArgumentsThrowClearly) {
+  const Ball b;
+  ConstraintList c{std::make_shared<RollingBall>("contact", 0, b.R)};
+  EXPECT_THROW(Simulator(b.model, c, nullptr, IntegratorType::RK4), std::invalid_argument);
+  Simulator sim(b.model, c, std::make_unique<KktSolver>(b.model, c), IntegratorType::RK4);
+  EXPECT_THROW(sim.setState(0, VecX::Zero(3), b.v0), std::invalid_argument);
+  VecX bad = b.v0;
+  bad[1] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(sim.setState(0, b.q0, bad), std::invalid_argument);
+  EXPECT_THROW(sim.step(0.0), std::invalid_argument);
+  EXPECT_THROW(sim.step(-1e-3), std::invalid_argument);
+  EXPECT_THROW(sim.contactFrame(1), std::out_of_range);
+}
+
+TEST(SimulatorFailure, InitialStateIsProjectedOntoTheConstraints) {
+  const Ball b;
+  ConstraintList c{std::make_shared<RollingBall>("contact", 0, b.R)};
+  Simulator sim(b.model, c, std::make_unique<AppellSolver>(b.model, c), IntegratorType::RK4);
+  VecX q = b.q0, v = b.v0;
+  q[2] += 0.02;   // above the plane
+  v[3] += 0.5;    // slipping
+  v[5] -= 0.3;    // leaving the plane
+  sim.setState(0, q, v);
+  EXPECT_GT(sim.gapResidual(), 0.01);
+  EXPECT_GT(sim.velocityResidual(), 0.1);
+  const StepStatus st = sim.projectState();
+  ASSERT_TRUE(st.ok) << st.message;
+  EXPECT_LT(sim.gapResidual(), 1e-12);
+  EXPECT_LT(sim.velocityResidual(), 1e-12);
+  EXPECT_GE(sim.lastProjection().iterations, 1);
+  EXPECT_NEAR(sim.q()[2], b.R, 1e-12);
+  // The impulse that removed the slip and the lift: v⁺ = v − M⁻¹Aᵀμ.
+  EXPECT_GT(sim.lastImpulse().norm(), 0.0);
+}
+
+}  // namespace
+}  // namespace appell
