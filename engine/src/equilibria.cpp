@@ -158,9 +158,15 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
     J.leftCols(nv) = Jt;
     J.rightCols(m).setZero();
     J.topRightCorner(nv, m) = res.cd().A.transpose() / fs;
+    // Column scaling, floored: a column that is zero up to finite-difference
+    // noise (a direction along the equilibrium manifold, e.g. a cyclic
+    // coordinate) must not be blown up to unit size — the minimum-norm step
+    // would then move far along it to cancel noise.
+    double cmax = 0;
+    for (int c = 0; c < nx; ++c) cmax = std::max(cmax, J.col(c).norm());
     for (int c = 0; c < nx; ++c) {
-      const double n = J.col(c).norm();
-      D[c] = n > 1e-300 ? n : 1.0;
+      D[c] = std::max(J.col(c).norm(), 1e-3 * cmax);
+      if (!(D[c] > 0)) D[c] = 1.0;
       Js.col(c) = J.col(c) / D[c];
     }
     const VecX grad = Js.transpose() * F;
@@ -174,7 +180,11 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
     for (int tries = 0; tries < 16 && !accepted; ++tries) {
       VecX ds;
       if (mu == 0) {
-        ds = Eigen::CompleteOrthogonalDecomposition<MatX>(Js).solve(-F);
+        // Singular values below the finite-difference noise are rank
+        // deficiency, not directions to follow.
+        Eigen::CompleteOrthogonalDecomposition<MatX> cod(Js);
+        cod.setThreshold(1e-6);
+        ds = cod.solve(-F);
       } else {
         MatX Aug(ne + nx, nx);
         Aug << Js, std::sqrt(mu) * MatX::Identity(nx, nx);

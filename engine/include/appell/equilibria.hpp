@@ -30,7 +30,7 @@ struct EquilibriumOptions {
   VecX tau;                       ///< joint forces (size nv); empty = none
   double time = 0;                ///< t at which the constraints are evaluated
   /// Converged when ‖Q + Aᵀλ‖∞ ≤ tolerance · force_scale and ‖g‖∞ ≤ tolerance · length_scale.
-  double tolerance = 1e-10;
+  double tolerance = 1e-12;
   /// Force scale; ≤ 0: max(‖Q(q_guess)‖∞, total weight), or 1 if both vanish.
   double force_scale = -1;
   double length_scale = 1.0;      ///< metres: weights the gaps against the forces
