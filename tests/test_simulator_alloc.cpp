@@ -3,6 +3,7 @@
 // nonholonomic rows, a second body and a joint-force callback. The global
 // operator new is replaced in this file and counts while armed.
 #include <appell/appell_maggi.hpp>
+#include <appell/contacts.hpp>
 #include <appell/kkt.hpp>
 #include <appell/simulator.hpp>
 
@@ -126,6 +127,55 @@ TEST(SimulatorAllocation, StepDoesNotAllocate) {
       EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
       EXPECT_LT(sim.velocityResidual(), 1e-10);
     }
+  }
+}
+
+// The same with the contacts module's rolling rows on a four-wheeled car
+// (a tree of five bodies, 12 rows of rank 9), rear-wheel drive.
+TEST(SimulatorAllocation, CarWithContactRowsDoesNotAllocate) {
+  ModelBuilder b;
+  const int chassis = b.addBody("chassis", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+                                Inertia{10, Vec3(0.1, 0, 0.1), Vec3(1, 2, 2.5).asDiagonal()});
+  ConstraintList c;
+  const double r = 0.3;
+  for (int k = 0; k < 4; ++k) {
+    SE3 X;
+    X.p = Vec3(k < 2 ? 1.0 : -1.0, k % 2 ? -0.6 : 0.6, 0);
+    const int w = b.addBody("wheel" + std::to_string(k), chassis, X, JointType::Continuous,
+                            Vec3::UnitY(), Inertia{1, Vec3::Zero(), Vec3::Constant(0.036).asDiagonal()});
+    c.push_back(makeContact(ContactKind::Rolling, w, Sphere{r, Vec3::Zero()},
+                            Support{Plane{}, StaticMotion{}, "ground", -1}));
+  }
+  const Model model = b.build();
+  VecX q = neutralConfiguration(model);
+  q[2] = r;
+  VecX v = VecX::Zero(model.nv);
+  v[3] = 1.5;
+  for (int k = 0; k < 4; ++k) v[6 + k] = 1.5 / r;
+  for (int which = 0; which < 3; ++which) {
+    std::unique_ptr<ConstrainedSolver> solver;
+    if (which == 0) solver = std::make_unique<KktSolver>(model, c);
+    if (which == 1) solver = std::make_unique<AppellSolver>(model, c);
+    if (which == 2)
+      solver = std::make_unique<AppellSolver>(model, c, SolverOptions{},
+                                              AppellOptions{NullSpace::CoordinatePartition});
+    Simulator sim(model, c, std::move(solver), IntegratorType::DormandPrince54);
+    sim.setJointForces([](double, const VecX&, const VecX&, VecX& tau) {
+      tau[8] = tau[9] = 0.3;
+    });
+    sim.setState(0, q, v);
+    long allocations = 0;
+    for (int k = 0; k < 30; ++k) {
+      StepStatus st;
+      {
+        Arm arm;
+        st = sim.step(1e-2);
+        allocations += g_allocations;
+      }
+      ASSERT_TRUE(st.ok) << st.message;
+    }
+    EXPECT_EQ(allocations, 0) << "solver " << which;
+    EXPECT_EQ(sim.redundantRows(), 3);
   }
 }
 

@@ -147,6 +147,8 @@ TEST(SolverAgreement, ThousandRandomStatesKktAppellUdwadiaKalaba) {
       }
       worst_uk = std::max(worst_uk, rel(rk.vdot, ref.vdot));
       EXPECT_LT(rel(rk.vdot, ref.vdot), 1e-9);
+      EXPECT_LT(rel(ro.vdot, ref.vdot), 1e-9);
+      EXPECT_LT(rel(rp.vdot, ref.vdot), 1e-9);
       if (cd.m > 0) {
         worst_ref_lambda = std::max(worst_ref_lambda, rel(rk.lambda, ref.lambda));
         EXPECT_LT(rel(rk.lambda, ref.lambda), 1e-8);  // SVD reference, squared conditioning
