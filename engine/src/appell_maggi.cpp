@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 namespace appell {
 
@@ -44,7 +45,6 @@ struct AppellSolver::Impl {
   int changes = 0;
   bool changed_last = false;
   double cond = 1, cond_at_change = 0;
-  int rank_before_change = -1;
 
   double dependentCondition() {
     if (kmax == 0) return 1.0;
@@ -85,7 +85,6 @@ struct AppellSolver::Impl {
         changed_last = true;
         prev_dep = dep;
         prev_ndep = ndep;
-        rank_before_change = ndep;
       }
       // Column pivoting on the independent rows picks the best-conditioned
       // dependent velocities (Businger–Golub; Wehage & Haug 1982).
