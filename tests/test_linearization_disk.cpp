@@ -56,7 +56,9 @@ TEST(DiskLinearization, StraightRollingMatchesTheAnalyticEigenvalues) {
       for (int k = 2; k < 4; ++k)
         EXPECT_LT(std::min(std::abs(ev[k] - mu), std::abs(ev[k] + mu)), 1e-6 * std::abs(mu))
             << toString(solver->formulation()) << " s = " << s << ": " << ev[k] << " vs ±" << mu;
-      if (mu2 < 0) EXPECT_LT(std::abs(ev[2].real()), 1e-6);  // stable: purely imaginary
+      if (mu2 < 0) {
+        EXPECT_LT(std::abs(ev[2].real()), 1e-6);  // stable: purely imaginary
+      }
     }
   }
 }

@@ -47,7 +47,7 @@ struct LinearizationResult {
   Eigen::VectorXcd eigenvalues; ///< of L (Eigen::EigenSolver)
   VecX drift;                   ///< θ̇ at the reference (nv): the cyclic rates of a steady motion
   double steady_residual = 0;   ///< ‖f_r(x*)‖∞: 0 for an equilibrium / relative equilibrium
-  double symmetry_residual = 0; ///< max |∂f/∂θ_c| over cyclic c (0 when truly cyclic)
+  double symmetry_residual = 0; ///< max |∂f_r/∂θ_c| over cyclic c (0 when truly cyclic)
   double constraint_residual = 0;  ///< ‖(g, A v + b)‖∞ at the reference
 };
 
