@@ -163,7 +163,7 @@ struct AppellSolver::Impl {
     r.noalias() = M * x;
     const double scale = r.norm() + f.norm() + std::numeric_limits<double>::min();
     r -= f;
-    basis.minNorm(B, r, lambda);
+    basis.minNorm(r, lambda);
     range_residual = basis.rangeResidual() / scale;
     if (!(range_residual <= ao.range_tol)) {
       std::ostringstream os;

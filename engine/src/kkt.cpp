@@ -65,7 +65,7 @@ struct KktSolver::Impl {
   void factorRows(const MatX& A, const SolverOptions& opt) {
     B = A.transpose();
     llt.matrixL().solveInPlace(B);
-    basis.factor(B, opt);
+    basis.factor(B, opt, /*form_q=*/false);
   }
 };
 
@@ -118,7 +118,7 @@ void KktSolver::solve(const Model& model, Data& data, const ConstraintList& cons
   out.vdot = w.y;
   w.llt.matrixU().solveInPlace(out.vdot);
   out.vdot += w.a;
-  w.basis.minNorm(w.B, w.y, out.lambda);
+  w.basis.minNormOfSolution(out.lambda);
   out.reaction.noalias() = cdata.A.transpose() * out.lambda;
 }
 
@@ -147,7 +147,7 @@ bool KktSolver::projectVelocity(const Model& model, Data& data, const Constraint
     last_error_ = w.basis.describeInconsistency(constraints, cdata);
     return false;
   }
-  w.basis.minNorm(w.B, w.y, w.lambda);  // M(v⁺ − v) = Aᵀλ
+  w.basis.minNormOfSolution(w.lambda);  // M(v⁺ − v) = Aᵀλ
   impulse = -w.lambda;                  // v⁺ = v − M⁻¹Aᵀμ
   w.llt.matrixU().solveInPlace(w.y);
   v += w.y;

@@ -9,11 +9,12 @@ namespace appell::detail {
 RowBasis::RowBasis(int n, int m)
     : n_(n), m_(m), k_(std::min(n, m)), D_(VecX::Zero(m)), Be_(MatX::Zero(n, m)),
       qr_(n, m), Q_(MatX::Identity(n, n)), work_n_(VecX::Zero(n)), work_m_(VecX::Zero(m)),
-      pd_(VecX::Zero(m)), z_(VecX::Zero(n)), E_(MatX::Zero(m, m)), eqr_(m, m), Qe_(MatX::Identity(m, m)),
+      pd_(VecX::Zero(m)), z_(VecX::Zero(n)), E_(MatX::Zero(m, m)), eqr_(m, m),
       w_(VecX::Zero(m)) {}
 
-void RowBasis::factor(const MatX& B, const SolverOptions& options) {
+void RowBasis::factor(const MatX& B, const SolverOptions& options, bool form_q) {
   opt_ = options;
+  form_q_ = form_q;
   Be_ = B;
   double max_norm = 0;
   for (int j = 0; j < m_; ++j) max_norm = std::max(max_norm, Be_.col(j).norm());
@@ -40,7 +41,7 @@ void RowBasis::factor(const MatX& B, const SolverOptions& options) {
   const double r00 = std::abs(R(0, 0));
   const double threshold = options.rank_abs_tol + options.rank_rel_tol * r00;
   while (rank_ < k_ && std::abs(R(rank_, rank_)) > threshold) ++rank_;
-  qr_.householderQ().evalTo(Q_, work_n_);
+  if (form_q_) qr_.householderQ().evalTo(Q_, work_n_);
 }
 
 bool RowBasis::solveRows(const VecX& d, VecX& y) {
@@ -66,7 +67,12 @@ bool RowBasis::solveRows(const VecX& d, VecX& y) {
     auto z = z_.head(rank_);
     z = pd_.head(rank_);
     qr_.matrixQR().topLeftCorner(rank_, rank_).triangularView<Eigen::Upper>().transpose().solveInPlace(z);
-    y.noalias() = Q1() * z;
+    if (form_q_) {
+      y.noalias() = Q1() * z;
+    } else {
+      y.head(rank_) = z;
+      applyQ(qr_, k_, y);
+    }
   }
   // Dropped rows: R₁₂ᵀ z must reproduce their right-hand sides.
   for (int j = rank_; j < m_; ++j) {
@@ -83,7 +89,31 @@ bool RowBasis::solveRows(const VecX& d, VecX& y) {
   return bad_pivot_ < 0 && zero_row_ < 0;
 }
 
-void RowBasis::minNorm(const MatX& B, const VecX& y, VecX& lambda) {
+template <class QR>
+void RowBasis::applyQ(const QR& qr, int reflectors, VecX& x) {
+  const auto& H = qr.matrixQR();
+  const int n = static_cast<int>(H.rows());
+  for (int j = reflectors - 1; j >= 0; --j) {
+    // H_j = I − τ v vᵀ with v = [1; essential part stored below the diagonal].
+    const double tau = qr.hCoeffs()[j];
+    if (tau == 0) continue;
+    auto ess = H.col(j).tail(n - j - 1);
+    auto tail = x.tail(n - j - 1);
+    const double dot = x[j] + ess.dot(tail);
+    x[j] -= tau * dot;
+    tail -= (tau * dot) * ess;
+  }
+}
+
+void RowBasis::minNormOfSolution(VecX& lambda) {
+  lambda.setZero();
+  range_residual_ = 0;
+  if (m_ == 0 || rank_ == 0) return;
+  w_.head(rank_) = z_.head(rank_);
+  minNormFromRowSpace(lambda);
+}
+
+void RowBasis::minNorm(const VecX& y, VecX& lambda) {
   lambda.setZero();
   range_residual_ = 0;
   if (m_ == 0) return;
@@ -94,16 +124,26 @@ void RowBasis::minNorm(const MatX& B, const VecX& y, VecX& lambda) {
     range_residual_ = outside.norm();
   }
   if (rank_ == 0) return;
-  auto s = w_.head(rank_);
-  s.noalias() = Q1().transpose() * y;
-  // K λ = s with K = Q₁ᵀ B (rank × m, full row rank). Kᵀ = Q_E R_E, so the
-  // minimum-norm solution is λ = Q_E [R_E⁻ᵀ s; 0] (it lies in range(Kᵀ)).
+  w_.head(rank_).noalias() = Q1().transpose() * y;
+  minNormFromRowSpace(lambda);
+}
+
+void RowBasis::minNormFromRowSpace(VecX& lambda) {
+  // Kᵀ = D⁻¹ P R₁ᵀ: row i = pivot(j) of Kᵀ is column j of R₁ times ‖B_i‖.
+  // Rows the rank decision called zero (D_i = 0) take no multiplier.
   E_.setZero();
-  E_.leftCols(rank_).noalias() = B.transpose() * Q1();
+  const auto& R = qr_.matrixQR();
+  for (int j = 0; j < m_; ++j) {
+    const int i = pivot(j);
+    if (D_[i] == 0) continue;
+    const int top = std::min(rank_, j + 1);
+    for (int k = 0; k < top; ++k) E_(i, k) = R(k, j) / D_[i];
+  }
   eqr_.compute(E_);
+  auto s = w_.head(rank_);
   eqr_.matrixQR().topLeftCorner(rank_, rank_).triangularView<Eigen::Upper>().transpose().solveInPlace(s);
-  eqr_.householderQ().evalTo(Qe_, work_m_);
-  lambda.noalias() = Qe_.leftCols(rank_) * s;
+  lambda.head(rank_) = s;
+  applyQ(eqr_, m_, lambda);
 }
 
 std::string rowName(const ConstraintList& constraints, const ConstraintData& cdata, int i) {

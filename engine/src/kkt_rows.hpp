@@ -31,11 +31,15 @@ class RowBasis {
   int n() const { return n_; }
   int m() const { return m_; }
 
-  /// Equilibrates and factors the rows (columns of B, n × m).
-  void factor(const MatX& B, const SolverOptions& options);
+  /// Equilibrates and factors the rows (columns of B, n × m). With
+  /// `form_q` the orthogonal factor is formed explicitly (Q1(), Q2(), and
+  /// minNorm() of an arbitrary y need it); without, y = Q₁z is applied from
+  /// the Householder reflectors (O(n·min(n, m)) instead of O(n²·min(n, m))).
+  void factor(const MatX& B, const SolverOptions& options, bool form_q = true);
   int rank() const { return rank_; }
 
-  /// Orthonormal bases of the row space and of the null space of the rows.
+  /// Orthonormal bases of the row space and of the null space of the rows
+  /// (only after factor(…, form_q = true)).
   Eigen::Block<const MatX, Eigen::Dynamic, Eigen::Dynamic, true> Q1() const { return Q_.leftCols(rank_); }
   Eigen::Block<const MatX, Eigen::Dynamic, Eigen::Dynamic, true> Q2() const { return Q_.rightCols(n_ - rank_); }
 
@@ -45,11 +49,14 @@ class RowBasis {
   /// (describeInconsistency() says which rows).
   bool solveRows(const VecX& d, VecX& y);
 
-  /// Minimum-norm λ with B λ = y, for y in range(B) (the part of y outside it
-  /// is ignored; rangeResidual() reports ‖Q₂ᵀ y‖). B must be the matrix given
-  /// to factor(). Computed from a Householder QR of (Q₁ᵀB)ᵀ, m × rank, held
-  /// in an m × m matrix padded with zero columns so that its size is fixed.
-  void minNorm(const MatX& B, const VecX& y, VecX& lambda);
+  /// Minimum-norm λ with B λ = y for the y of the last solveRows() (y = Q₁z):
+  /// K λ = z with K = Q₁ᵀB = R₁PᵀD⁻¹ (read off the factorization, no Q
+  /// needed). Kᵀ (m × rank, padded to m × m so that its size is fixed) is
+  /// factored by Householder QR, Kᵀ = Q_E R_E, and λ = Q_E [R_E⁻ᵀ z; 0].
+  void minNormOfSolution(VecX& lambda);
+  /// Minimum-norm λ with B λ = y for any y (its part outside range(B) is
+  /// ignored; rangeResidual() reports ‖Q₂ᵀ y‖). Needs form_q.
+  void minNorm(const VecX& y, VecX& lambda);
   double rangeResidual() const { return range_residual_; }
 
   /// Original row index of pivot position k (the first rank() are independent).
@@ -80,7 +87,13 @@ class RowBasis {
   // Minimum-norm multipliers.
   MatX E_;                  // m × m
   Eigen::HouseholderQR<MatX> eqr_;
-  MatX Qe_;                 // m × m
+  bool form_q_ = true;
+
+  /// x ← H₀H₁…H_{k−1} x for the reflectors stored in `qr` (Q x without forming Q).
+  template <class QR>
+  static void applyQ(const QR& qr, int reflectors, VecX& x);
+  /// λ from K λ = s (s: first rank entries of `w_`).
+  void minNormFromRowSpace(VecX& lambda);
   VecX w_;                  // m
   double range_residual_ = 0;
   // Last inconsistency: pivot position of the worst dropped row (−1: a zero row

@@ -98,7 +98,7 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
     for (int k = 0; k < w.mh; ++k) w.Ah.row(k) = cdata.A.row(w.row_map[k]);
     w.B = w.Ah.transpose();
     w.llt.matrixL().solveInPlace(w.B);
-    w.basis.factor(w.B, w.opt.rank);
+    w.basis.factor(w.B, w.opt.rank, /*form_q=*/false);
     res.rank = w.basis.rank();
     w.g = -w.g;
     if (!w.basis.solveRows(w.g, w.y))
