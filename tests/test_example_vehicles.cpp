@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <variant>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -142,6 +143,20 @@ TEST(ExampleDiffDrive, MeshesLoadFromStlAndDae) {
     worst = std::max(worst, best);
   }
   EXPECT_LT(worst, 1e-6);
+}
+
+TEST(ExampleDiffDrive, TyresAreToriFromTheCylinderCollisions) {
+  const Scene s = loadScene(examplePath("diff_drive/diff_drive.urdf"));
+  ASSERT_EQ(s.contacts.size(), 3u);
+  for (int k = 0; k < 2; ++k) {
+    const auto* torus = std::get_if<Torus>(&s.contacts[k].shape);
+    ASSERT_NE(torus, nullptr) << s.contacts[k].name << ": " << shapeName(s.contacts[k].shape);
+    EXPECT_NEAR(torus->major + torus->minor, 0.1, 1e-15);  // outer radius = the cylinder's
+    EXPECT_NEAR(torus->minor, 0.02, 1e-15);
+    EXPECT_NEAR(std::abs(torus->axis.dot(Vec3::UnitY())), 1.0, 1e-12);  // the axle, link frame
+  }
+  EXPECT_NE(std::get_if<Sphere>(&s.contacts[2].shape), nullptr);
+  EXPECT_EQ(s.contacts[2].kind, ContactKind::Sliding);
 }
 
 TEST(ExampleDiffDrive, EqualTorquesDriveStraightWithTheClosedFormAcceleration) {
