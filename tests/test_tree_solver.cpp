@@ -253,3 +253,79 @@ TEST(TreeSolver, RejectsBadConstraints) {
   ConstraintList nobody{std::make_shared<LocalRows>("ghost", -1, K)};
   EXPECT_THROW(TreeSolver(model, nobody), std::invalid_argument);
 }
+
+TEST(TreeSolver, ProjectVelocityIsTheMassMetricProjection) {
+  std::mt19937 rng(20);
+  for (int n : {1, 4, 12, 30}) {
+    for (bool floating : {false, true}) {
+      System s = randomSystem(n, floating, rng, RowRecipe{0.3, 0.3, 2});
+      const ConstraintList list = s.list();
+      Data data(s.model);
+      ConstraintData cd(s.model, list);
+      evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+      const VecX ref = denseProjection(s.model, cd, s.q, s.v);
+      TreeSolver solver(s.model, list);
+      VecX v = s.v, mu;
+      ASSERT_TRUE(solver.projectVelocity(s.model, data, list, cd, s.q, v, mu)) << solver.lastError();
+      EXPECT_LT(relErr(v, ref), 1e-10) << "n=" << n;
+      if (cd.m == 0) continue;
+      EXPECT_LT((cd.A * v + cd.b).lpNorm<Eigen::Infinity>(), 1e-10 * std::max(1.0, cd.b.norm()));
+      // v⁺ = v − M⁻¹Aᵀμ.
+      const MatX M = crba(s.model, data, s.q);
+      EXPECT_LT(relErr(M * (s.v - v), cd.A.transpose() * mu), 1e-9) << "n=" << n;
+    }
+  }
+}
+
+TEST(TreeSolver, LoopRowsBetweenBodiesAndOverJoints) {
+  std::mt19937 rng(21);
+  for (int n : {3, 8, 20}) {
+    for (bool floating : {false, true}) {
+      for (int rep = 0; rep < 3; ++rep) {
+        System s = randomSystem(n, floating, rng, RowRecipe{0.2, 0.2, 1});
+        std::uniform_int_distribution<int> body(0, n - 1), nr(1, 3);
+        for (int c = 0; c < 2; ++c) {
+          const int m = nr(rng);
+          Rows Ka(m, 6), Kb(m, 6);
+          for (int r = 0; r < m; ++r) {
+            Ka.row(r) = randomRow(rng).transpose();
+            Kb.row(r) = randomRow(rng).transpose();
+          }
+          s.local.push_back(std::make_shared<LocalRows>("loop" + std::to_string(c), body(rng), Ka,
+                                                        body(rng), Kb));
+        }
+        MatX Aj = MatX::Random(2, s.model.nv);
+        s.joint.push_back(std::make_shared<JointRows>("joint", Aj));
+        makeConsistent(s, rng);
+        const Compared c = compare(s);
+        EXPECT_LT(c.vdot, 1e-10) << "n=" << n << " floating=" << floating << " rep=" << rep;
+        EXPECT_LT(c.reaction, 1e-10) << "n=" << n << " floating=" << floating;
+        EXPECT_EQ(c.rank, c.ref_rank);
+        if (c.full_rank) {
+          EXPECT_LT(c.lambda, 1e-8);
+        }
+      }
+    }
+  }
+}
+
+TEST(TreeSolver, RedundantLoopRowCopiesATreeRow) {
+  // A joint-space row equal to a tree row (its row of A): redundant, rank unchanged.
+  std::mt19937 rng(22);
+  System s = randomSystem(10, true, rng, RowRecipe{});
+  Rows K(2, 6);
+  K.row(0) = randomRow(rng).transpose();
+  K.row(1) = randomRow(rng).transpose();
+  s.local.push_back(std::make_shared<LocalRows>("tree_rows", 6, K));
+  const ConstraintList l0 = s.list();
+  Data data(s.model);
+  ConstraintData cd0(s.model, l0);
+  evaluateConstraints(s.model, data, l0, cd0, 0.0, s.q, s.v);
+  s.joint.push_back(std::make_shared<JointRows>("copy", 3.0 * cd0.A.bottomRows(1)));
+  makeConsistent(s, rng);
+  const Compared c = compare(s);
+  EXPECT_LT(c.vdot, 1e-10);
+  EXPECT_LT(c.reaction, 1e-10);
+  EXPECT_EQ(c.rank, c.ref_rank);
+  EXPECT_FALSE(c.full_rank);
+}

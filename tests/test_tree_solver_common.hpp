@@ -134,35 +134,46 @@ struct Reference {
   int rank = 0;
 };
 
-/// Udwadia–Kalaba with the symmetric square root of M.
+/// Udwadia–Kalaba with the symmetric square root of M, evaluated in long
+/// double so that the reference is not the least accurate party (the tree
+/// solver is often more accurate than the same formula in double).
 inline Reference denseReference(const Model& model, const ConstraintData& cd, const VecX& q,
                                 const VecX& v, const VecX& tau) {
+  using ML = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+  using VL = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
   Data data(model);
   const MatX M = crba(model, data, q);
   const VecX h = nonLinearEffects(model, data, q, v);
-  Eigen::SelfAdjointEigenSolver<MatX> es(M);
-  const MatX Mih = es.operatorInverseSqrt();
-  const VecX a = M.ldlt().solve(tau - h);
+  const ML Ml = M.cast<long double>();
+  const VL rhs = (tau - h).cast<long double>();
+  Eigen::SelfAdjointEigenSolver<ML> es(Ml);
+  const ML Mih = es.operatorInverseSqrt();
+  const VL a = Ml.ldlt().solve(rhs);
   Reference r;
   if (cd.m == 0) {
-    r.vdot = a;
+    r.vdot = a.cast<double>();
     r.lambda = VecX::Zero(0);
     r.reaction = VecX::Zero(model.nv);
     return r;
   }
-  const MatX B = cd.A * Mih;
-  r.vdot = a + Mih * pinvSolve(B, -cd.abias - cd.A * a);
-  r.reaction = M * r.vdot + h - tau;
-  r.lambda = pinvSolve(cd.A.transpose(), r.reaction);
-  Eigen::JacobiSVD<MatX> svd(cd.A);
-  svd.setThreshold(1e-10);
-  r.rank = static_cast<int>(svd.rank());
+  const ML A = cd.A.cast<long double>();
+  Eigen::JacobiSVD<ML> svd(A * Mih, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  svd.setThreshold(1e-10L);
+  const VL vd = a + Mih * svd.solve(VL(-cd.abias.cast<long double>() - A * a));
+  const VL reaction = Ml * (vd - a);
+  Eigen::JacobiSVD<ML> svdt(A.transpose(), Eigen::ComputeThinU | Eigen::ComputeThinV);
+  svdt.setThreshold(1e-10L);
+  r.vdot = vd.cast<double>();
+  r.reaction = reaction.cast<double>();
+  r.lambda = svdt.solve(reaction).cast<double>();
+  r.rank = static_cast<int>(svdt.rank());
   return r;
 }
 
 /// Dense M-metric projection v⁺ = v + M^{-½}(A M^{-½})⁺(−b − A v).
 inline VecX denseProjection(const Model& model, const ConstraintData& cd, const VecX& q,
                             const VecX& v) {
+  if (cd.m == 0) return v;
   Data data(model);
   const MatX M = crba(model, data, q);
   Eigen::SelfAdjointEigenSolver<MatX> es(M);

@@ -5,6 +5,7 @@
 
 #include "tree_solver_workspace.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace appell {
@@ -71,6 +72,9 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   ws.vdot = VecX::Zero(model.nv);
   ws.lambda = VecX::Zero(ws.m);
   ws.fsub.assign(model.nbodies, Vec6::Zero());
+  ws.vdot_acc = VecX::Zero(model.nv);
+  ws.lambda_acc = VecX::Zero(ws.m);
+  ws.resid_f = VecX::Zero(model.nv);
   ws.a0.assign(model.nbodies, Vec6::Zero());
   const int k = static_cast<int>(ws.loops.size());
   if (k > 0) {
@@ -80,7 +84,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
     ws.schur_svd = Eigen::JacobiSVD<MatX>(k, k, Eigen::ComputeThinU | Eigen::ComputeThinV);
     ws.vdot0 = VecX::Zero(model.nv);
     ws.lambda0 = VecX::Zero(ws.m);
-    for (VecX* x : {&ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp})
+    for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp})
       *x = VecX::Zero(k);
   }
 }
@@ -96,6 +100,16 @@ void checkSizes(const Model& model, const ConstraintData& cdata, const detail::T
   if (model.nbodies != ws.nbodies || model.nv != ws.nv || cdata.m != ws.m)
     throw std::invalid_argument(
         "TreeSolver: the model or constraint set differs from the one the solver was built for");
+}
+
+/// Refinement steps for the smallest pivot the factor pass divided by: the
+/// recursion's error grows like eps/σ⁴ (tree_solver_refine.cpp), each step
+/// squares the relative error.
+/// Loop rows always get one step: their unit responses are summed through a
+/// Schur complement whose error is not bounded by the tree pivots alone.
+int refinementSteps(double min_pivot, bool loops) {
+  const int s = min_pivot < 5e-4 ? 3 : min_pivot < 5e-3 ? 2 : min_pivot < 5e-2 ? 1 : 0;
+  return loops ? std::max(s, 1) : s;
 }
 
 /// Velocity products and bias forces of the current state (ABA's first pass).
@@ -142,12 +156,16 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   ws.a_world = spatial(Vec3::Zero(), -model.gravity);
   ws.use_c = true;
   ws.lambda.setZero();
+  detail::loopTargets(model, data, cdata, ws, v, false);
   if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||
-      !detail::solveLoops(model, data, cdata, ws, v, false)) {
+      !detail::solveLoops(model, data, cdata, ws)) {
     out.ok = false;
     out.error = detail::describeFailure(model, data, ws);
     return;
   }
+  ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;
+  for (int s = refinementSteps(ws.min_pivot, !ws.loops.empty()); s > 0; --s)
+    detail::refine(model, data, cdata, ws, q, v, tau, false);
   out.vdot = ws.vdot;
   out.lambda = ws.lambda;
   detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
@@ -182,11 +200,14 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
   ws.a_world.setZero();
   ws.use_c = false;
   ws.lambda.setZero();
+  detail::loopTargets(model, data, cdata, ws, v, true);
   if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||
-      !detail::solveLoops(model, data, cdata, ws, v, true)) {
+      !detail::solveLoops(model, data, cdata, ws)) {
     ws.last_error = detail::describeFailure(model, data, ws);
     return false;
   }
+  for (int s = refinementSteps(ws.min_pivot, !ws.loops.empty()); s > 0; --s)
+    detail::refine(model, data, cdata, ws, q, v, ws.tau, true);
   v += ws.vdot;
   impulse = -ws.lambda;  // the shared convention: v⁺ = v − M⁻¹Aᵀμ
   return true;

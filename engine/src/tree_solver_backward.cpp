@@ -60,6 +60,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
   const SolverOptions& o = ws.options;
   for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].IA = model.spatial_inertia[i];
   ws.redundant = 0;
+  ws.min_pivot = 1;
 
   for (int i = model.nbodies - 1; i >= 0; --i) {
     Node& nd = ws.nodes[i];
@@ -119,6 +120,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       const auto& s = ws.svd.singularValues();
       const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * s(0));
       while (rho < s.size() && s(rho) > thr) ++rho;
+      if (rho > 0) ws.min_pivot = std::min(ws.min_pivot, s(rho - 1));
       const auto& Um = ws.svd.matrixU();
       const auto& Vm = ws.svd.matrixV();
       if (rho > 0)

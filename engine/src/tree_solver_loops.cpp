@@ -29,7 +29,7 @@ double applyRow(const ConstraintData& cdata, const Data& data, const TreeWorkspa
 }  // namespace
 
 bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdata,
-                TreeWorkspace& ws, const VecX& v, bool impulse) {
+                TreeWorkspace& ws) {
   const int k = static_cast<int>(ws.loops.size());
   if (k == 0) return true;
   const SolverOptions& o = ws.options;
@@ -38,24 +38,8 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
   ws.vdot0 = ws.vdot;
   ws.lambda0 = ws.lambda;
   for (int i = 0; i < model.nbodies; ++i) ws.a0[i] = ws.nodes[i].a;
-  for (int l = 0; l < k; ++l) {
-    const LoopRow& lr = ws.loops[l];
-    const RowBlock& blk = cdata.blocks[lr.constraint];
-    double rhs;
-    if (lr.joint_space) {
-      rhs = impulse ? -(blk.A_joint.row(lr.row).dot(v) + blk.b_joint[lr.row])
-                    : -blk.abias_joint[lr.row];
-    } else if (impulse) {
-      const Vec6 VA = data.oMi[lr.bodyA].act(data.v[lr.bodyA]);
-      const Vec6 VB = data.oMi[lr.bodyB].act(data.v[lr.bodyB]);
-      rhs = -(blk.Wa.row(lr.row).dot(VA) - blk.Wb.row(lr.row).dot(VB) + blk.b[lr.row]);
-    } else {
-      // On gravity-shifted accelerations a' = a − g (both bodies see the same g).
-      rhs = -blk.kappa[lr.row] -
-            (blk.Wa.row(lr.row).tail<3>() - blk.Wb.row(lr.row).tail<3>()).dot(model.gravity);
-    }
-    ws.loop_rhs[l] = rhs - applyRow(cdata, data, ws, lr, ws.vdot0, &ws.a0);
-  }
+  for (int l = 0; l < k; ++l)
+    ws.loop_rhs[l] = ws.loop_target[l] - applyRow(cdata, data, ws, ws.loops[l], ws.vdot0, &ws.a0);
 
   // Unit solves: the response to each loop row's generalized force B_lᵀ,
   // with no velocity terms, no gravity and homogeneous tree rows.
@@ -110,6 +94,8 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
   int rank = 0;
   while (rank < k && s(rank) > thr) ++rank;
   ws.loop_rank = rank;
+  // The Schur solve divides by these: let refinement know (tree_solver_refine.cpp).
+  if (rank > 0) ws.min_pivot = std::min(ws.min_pivot, s(rank - 1) / s(0));
   ws.loop_tmp.noalias() = ws.schur_svd.matrixU().transpose() * ws.loop_res;
   for (int l = 0; l < k; ++l) ws.loop_tmp[l] = l < rank ? ws.loop_tmp[l] / s(l) : 0.0;
   ws.loop_lambda.noalias() = ws.schur_svd.matrixV() * ws.loop_tmp;
@@ -133,7 +119,6 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
     return false;
   }
   ws.loop_lambda.array() *= ws.loop_scale.array();
-  ws.redundant += k - rank;
 
   ws.vdot = ws.vdot0;
   ws.vdot.noalias() += ws.W * ws.loop_lambda;

@@ -129,13 +129,17 @@ struct TreeWorkspace {
   VecX vdot, lambda;
   int redundant = 0;
   Failure failure;
+  /// Smallest singular value of K S kept by any joint (rows equilibrated, S
+  /// unit): the pivots the recursion divides by. Decides refinement steps.
+  double min_pivot = 1;
+  VecX vdot_acc, lambda_acc, resid_f;
 
   // Loop closure: k unit solves and the Schur complement.
   MatX W;                                 ///< nv × k, response to each loop row's force
   MatX L;                                 ///< m × k, tree multipliers of each response
   MatX schur;                             ///< k × k
   Eigen::JacobiSVD<MatX> schur_svd;
-  VecX vdot0, lambda0, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp;
+  VecX vdot0, lambda0, loop_target, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp;
   std::vector<Vec6> a0;                   ///< body accelerations of the main pass
   std::vector<Vec6> fsub;                 ///< subtree constraint forces (world frame)
   int loop_rank = 0;
@@ -159,11 +163,19 @@ void unrollNode(TreeWorkspace& ws, int body, int from, VecX& lambda);
 /// subtree, projected on each joint's motion subspace.
 void reactionForces(const Model& model, const Data& data, const ConstraintData& cdata,
                     TreeWorkspace& ws, const VecX& lambda, VecX& reaction);
-/// Solves the loop rows on top of the main pass (ws.vdot, ws.lambda, body
-/// accelerations), for the dynamics or, with `impulse`, the velocity
-/// projection. Returns false (ws.failure, ws.last_error) when inconsistent.
+/// Solves the loop rows (right sides ws.loop_target) on top of the main pass
+/// (ws.vdot, ws.lambda, body accelerations). Returns false (ws.failure,
+/// ws.last_error) when inconsistent.
 bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdata,
-                TreeWorkspace& ws, const VecX& v, bool impulse);
+                TreeWorkspace& ws);
+/// Right sides of the loop rows (ws.loop_target) for the dynamics or, with
+/// `impulse`, the velocity projection.
+void loopTargets(const Model& model, const Data& data, const ConstraintData& cdata,
+                 TreeWorkspace& ws, const VecX& v, bool impulse);
+/// One step of iterative refinement on the KKT residual, reusing the
+/// factorization (tree_solver_refine.cpp). `impulse`: the projection problem.
+void refine(const Model& model, Data& data, const ConstraintData& cdata, TreeWorkspace& ws,
+            const VecX& q, const VecX& v, const VecX& tau, bool impulse);
 /// "…" message naming the constraints involved in the inconsistency of ws.failure.
 std::string describeFailure(const Model& model, const Data& data, TreeWorkspace& ws);
 
