@@ -38,6 +38,7 @@ struct SleighParams {
   double speed = 0.0;                        ///< initial speed along the blade
   double turn_rate = 0.0;                    ///< initial φ̇
   double duration = 5.0;
+  std::string name = "chaplygin_sleigh";
 };
 
 /// The seed's sleigh: CoM at distance l perpendicular to the blade.
@@ -47,6 +48,7 @@ inline SleighParams seedSleighParams(double l = 0.3, double alpha = 0.35) {
   p.incline = alpha;
   p.foot1 = Vec3(0.5, -2 * l, 0);
   p.foot2 = Vec3(-0.5, -2 * l, 0);
+  p.name = "seed_sleigh";
   return p;
 }
 
@@ -57,6 +59,7 @@ inline SleighParams usualSleighParams(double a = 0.3, double alpha = 0.35) {
   p.incline = alpha;
   p.foot1 = Vec3(0.8, 0.3, 0);
   p.foot2 = Vec3(0.8, -0.3, 0);
+  p.name = "usual_sleigh";
   return p;
 }
 
@@ -90,7 +93,7 @@ inline BuiltScene sleigh(const SleighParams& p = seedSleighParams()) {
   const int body = b.addBody("sleigh", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
                              principalInertia(p.mass, p.principal, p.com), "free");
   BuiltScene s;
-  s.name = "chaplygin_sleigh";
+  s.name = p.name;
   s.model = b.build();
   const Incline f = inclineFrame(p.incline);
   const Support slope{Plane{Vec3::Zero(), f.n}, StaticMotion{}, "incline"};
@@ -123,7 +126,7 @@ inline BuiltScene sleighReduced(const SleighParams& p = seedSleighParams()) {
   const int bs = b.addBody("sleigh", by, onSlope, JointType::Continuous, Vec3::UnitZ(),
                            principalInertia(p.mass, p.principal, p.com), "phi");
   BuiltScene s;
-  s.name = "chaplygin_sleigh_reduced";
+  s.name = p.name + "_reduced";
   s.model = b.build();
   CustomRows rows;
   rows.name = "blade";
