@@ -13,9 +13,11 @@
 //            monotonically to it. If s has no component along the largest
 //            axis, F stays finite at −a_max²; when it is ≤ 0 there the
 //            farthest point is not unique (two mirror points) — reported.
-// Convergence: |Δt| ≤ 4 ε (|t| + a_max²), checked, with an iteration cap.
+// Convergence: |Δt| ≤ tol (|t| + a_max²), tol = max(newton_tol, 4ε), with an
+// iteration cap; failure is reported, never returned as a point.
 #include "geometry_internal.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -86,7 +88,7 @@ bool ellipsoidExtremalNormal(const Ellipsoid& e, const Vec3& s_body, bool outsid
     if (d == 0 || !std::isfinite(d)) break;
     const double step = sec.F(t) / d;
     t -= step;
-    if (std::abs(step) <= 4 * eps * (std::abs(t) + scale)) {
+    if (std::abs(step) <= std::max(opt.newton_tol, 4 * eps) * (std::abs(t) + scale)) {
       converged = true;
       break;
     }

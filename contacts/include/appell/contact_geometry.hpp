@@ -42,9 +42,10 @@ struct GeometryOptions {
   /// Below this, directions count as parallel (a disk lying flat, a knife
   /// edge along the normal, a sphere centre on a wheel's axis).
   double singular_tol = 1e-9;
-  /// Newton on the ellipsoid–sphere pair: converged when the tangential
-  /// residual is below tol × (size of the ellipsoid); at most max_iterations.
-  double newton_tol = 1e-14;
+  /// Newton on the ellipsoid–sphere pair's secular equation F(t) = 0:
+  /// converged when the step |Δt| ≤ newton_tol · (|t| + a_max²); at most
+  /// max_iterations, else the state is reported singular.
+  double newton_tol = 1e-15;
   int max_iterations = 60;
 };
 
