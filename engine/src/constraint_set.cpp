@@ -1,6 +1,9 @@
 #include <appell/constraint_set.hpp>
 #include <appell/kinematics.hpp>
 
+#include <algorithm>
+#include <cmath>
+
 namespace appell {
 
 ConstraintData::ConstraintData(const Model& model, const ConstraintList& constraints)
@@ -39,7 +42,9 @@ void evaluateConstraints(const Model& model, Data& data, const ConstraintList& c
       cd.A.middleRows(o, m) = blk.A_joint;
       cd.b.segment(o, m) = blk.b_joint;
       cd.abias.segment(o, m) = blk.abias_joint;
-      cd.gap.segment(o, m).setZero();
+      // Holonomic joint-space rows report their gaps in blk.gap (≤ 6 rows).
+      if (blk.gap.size() == m) cd.gap.segment(o, m) = blk.gap;
+      else cd.gap.segment(o, m).setZero();
       continue;
     }
     // Rows over body velocities: A = Wₐ Jₐ − W_b J_b, abias = κ + Wₐ J̇ₐv − W_b J̇_b v.
@@ -60,7 +65,9 @@ void evaluateConstraints(const Model& model, Data& data, const ConstraintList& c
 }
 
 double velocityResidual(const ConstraintData& cd, const VecX& v) {
-  return cd.m == 0 ? 0.0 : (cd.A * v + cd.b).lpNorm<Eigen::Infinity>();
+  double r = 0;  // row by row: no temporary vector
+  for (int i = 0; i < cd.m; ++i) r = std::max(r, std::abs(cd.A.row(i).dot(v) + cd.b[i]));
+  return r;
 }
 
 double gapResidual(const ConstraintData& cd) {
