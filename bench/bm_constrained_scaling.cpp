@@ -1,0 +1,93 @@
+// Constrained-dynamics solve per step on the scaling scenes (examples/scenes):
+// the O(n + m) tree solver against an unconstrained ABA on the same tree and
+// the dense KKT and Appell/Maggi references, for N = 8 … 1024 bodies.
+// Counters: ns_per_body (time per solve / bodies), bodies, rows.
+// The dense solvers stop at 256 bodies (O(n³); the comparison point is 256).
+// Each iteration evaluates nothing: the rows are evaluated once at a state
+// whose velocity satisfies them, and the solve alone is timed.
+#include <appell/appell_maggi.hpp>
+#include <appell/kkt.hpp>
+#include <appell/tree_solver.hpp>
+
+#include "car_row.hpp"
+#include "fleet.hpp"
+#include "ntrailer.hpp"
+#include "wheeled_snake.hpp"
+
+#include <benchmark/benchmark.h>
+
+using namespace appell;
+
+namespace {
+
+/// Scene of about `bodies` bodies.
+scenes::ScalingScene makeScene(int kind, int bodies) {
+  switch (kind) {
+    case 0: return scenes::nTrailer(std::max(1, bodies - 1));
+    case 1: return scenes::wheeledSnake(std::max(1, bodies / 3));
+    case 2: return scenes::fleet(std::max(1, bodies / 3));
+    default: return scenes::carRow(std::max(1, bodies / 5));
+  }
+}
+
+enum class Which { Tree, Aba, Kkt, Appell };
+
+void run(benchmark::State& st, Which which) {
+  auto s = makeScene(static_cast<int>(st.range(0)), static_cast<int>(st.range(1)));
+  Data data(s.model);
+  ConstraintData cd(s.model, s.constraints);
+  std::unique_ptr<ConstrainedSolver> solver;
+  switch (which) {
+    case Which::Tree:
+    case Which::Aba: solver = makeTreeSolver(s.model, s.constraints); break;
+    case Which::Kkt: solver = std::make_unique<KktSolver>(s.model, s.constraints); break;
+    case Which::Appell: solver = std::make_unique<AppellSolver>(s.model, s.constraints); break;
+  }
+  evaluateConstraints(s.model, data, s.constraints, cd, 0.0, s.q, s.v);
+  VecX v = s.v, mu;
+  if (!solver->projectVelocity(s.model, data, s.constraints, cd, s.q, v, mu)) {
+    st.SkipWithError("projection failed");
+    return;
+  }
+  evaluateConstraints(s.model, data, s.constraints, cd, 0.0, s.q, v);
+  const VecX tau = VecX::Constant(s.model.nv, 0.1);
+  ConstrainedResult out;
+  if (which == Which::Aba) {
+    for (auto _ : st) benchmark::DoNotOptimize(aba(s.model, data, s.q, v, tau).data());
+  } else {
+    solver->solve(s.model, data, s.constraints, cd, s.q, v, tau, out);
+    if (!out.ok) {
+      st.SkipWithError(out.error.c_str());
+      return;
+    }
+    for (auto _ : st) {
+      solver->solve(s.model, data, s.constraints, cd, s.q, v, tau, out);
+      benchmark::DoNotOptimize(out.vdot.data());
+    }
+  }
+  st.counters["bodies"] = s.model.nbodies;
+  st.counters["rows"] = cd.m;
+  st.counters["ns_per_body"] = benchmark::Counter(
+      static_cast<double>(st.iterations()) * s.model.nbodies * 1e-9,
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void sizes(benchmark::internal::Benchmark* b, int max_bodies) {
+  for (int kind = 0; kind < 4; ++kind)
+    for (int n = 8; n <= max_bodies; n *= 2) b->Args({kind, n});
+  b->ArgNames({"scene", "N"});
+  b->Unit(benchmark::kMicrosecond);
+}
+
+void BM_Tree(benchmark::State& st) { run(st, Which::Tree); }
+void BM_Aba(benchmark::State& st) { run(st, Which::Aba); }
+void BM_Kkt(benchmark::State& st) { run(st, Which::Kkt); }
+void BM_Appell(benchmark::State& st) { run(st, Which::Appell); }
+
+}  // namespace
+
+// scene: 0 N-trailer, 1 wheeled snake, 2 fleet, 3 car row.
+BENCHMARK(BM_Tree)->Apply([](auto* b) { sizes(b, 1024); });
+BENCHMARK(BM_Aba)->Apply([](auto* b) { sizes(b, 1024); });
+BENCHMARK(BM_Kkt)->Apply([](auto* b) { sizes(b, 256); });
+BENCHMARK(BM_Appell)->Apply([](auto* b) { sizes(b, 256); });
