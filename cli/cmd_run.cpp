@@ -103,11 +103,11 @@ int run(int argc, char** argv) {
   sopt.project_positions = sopt.project_velocities = !args.has("no-projection");
   Simulator sim(scene.model, scene.constraints, makeSolver(form, scene.model, scene.constraints),
                 itype, iopt, sopt);
-  sim.setState(0.0, scene.q0, scene.v0);
   if (scene.tau.size() == scene.model.nv) {
     const VecX tau = scene.tau;
     sim.setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
   }
+  sim.setState(0.0, scene.q0, scene.v0);  // after the forces: the t = 0 reactions include them
 
   std::ofstream csv;
   std::unique_ptr<TrajectoryWriter> writer;

@@ -27,7 +27,13 @@ const VecX& aba(const Model& model, Data& data, const VecX& q, const VecX& v, co
     if (j.nv > 0) {
       data.U[i] = data.IA[i] * j.S;
       const MatD D = j.S.transpose() * data.U[i];
-      const MatD Dinv = D.llt().solve(MatD::Identity(j.nv, j.nv));
+      // Most joints have one DoF: a division, not a general factorisation.
+      MatD Dinv(j.nv, j.nv);
+      if (j.nv == 1) {
+        Dinv(0, 0) = 1.0 / D(0, 0);
+      } else {
+        Dinv = D.llt().solve(MatD::Identity(j.nv, j.nv));
+      }
       data.Dinv[i].topLeftCorner(j.nv, j.nv) = Dinv;
       // Two statements on purpose: Eigen evaluates `segment − Sᵀ p` (a
       // dynamic-size segment minus a max-6 product) through a heap temporary.
