@@ -40,7 +40,10 @@ SupportMotion parseMotion(const XmlSource& src, const TiXmlElement* support) {
     } else if (tag == "twist") {
       allowOnly(src, m, {"angular", "linear"});
       ConstantTwistMotion t;
-      t.twist << vec3(src, m, "angular", Vec3::Zero()), vec3(src, m, "linear", Vec3::Zero());
+      // Read both before the comma initializer: a throw inside it would
+      // leave Eigen's initializer half-filled (an assertion in debug builds).
+      const Vec3 w = vec3(src, m, "angular", Vec3::Zero()), u = vec3(src, m, "linear", Vec3::Zero());
+      t.twist << w, u;
       motion = t;
     } else if (tag == "tilt") {
       allowOnly(src, m, {"axis", "point", "amplitude", "frequency", "phase"});
