@@ -17,6 +17,7 @@
 #include <Eigen/SVD>
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -147,7 +148,6 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
   double mu = 0;
   int it = 0, slow = 0;
   std::string stop = "iteration limit reached";
-  bool stationary = false;
   for (; it < opt.max_iterations; ++it) {
     if (maxAbs(F) <= tol) break;
     if (!res.jacobianTheta(q, lambda, fs, ls, Jt)) {
@@ -171,7 +171,6 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
     }
     const VecX grad = Js.transpose() * F;
     if (grad.norm() <= 1e-13 * std::max(1.0, Js.norm()) * F.norm()) {
-      stationary = true;
       stop = "the residual is stationary (a local minimum of ‖F‖ that is not zero)";
       break;
     }
@@ -207,7 +206,6 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
       }
     }
     if (!accepted) {
-      stationary = true;
       stop = "no step reduces the residual (a local minimum of ‖F‖ that is not zero)";
       break;
     }
@@ -256,7 +254,6 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
         << " iterations; " << stop;
   }
   out.message = msg.str();
-  (void)stationary;
 
   // Local dimension: directions δθ along which some δλ keeps F = 0 to first
   // order, i.e. the null space of P ∂F/∂θ, P = 1 − U Uᵀ with U spanning range(∂F/∂λ).
