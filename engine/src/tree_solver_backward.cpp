@@ -114,7 +114,31 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.
     const int nv = j.nv, nK = nd.nK;
     int rho = 0;
-    if (nK > 0 && nv > 0) {
+    if (nK > 0 && nv == 1) {
+      // One joint DoF: the SVD of the column g = K s is its norm and a
+      // Householder reflector H (H ĝ = ∓e₁) whose other columns span U₂.
+      KVec g(nK);
+      g.noalias() = nd.K * j.S.col(0);
+      const double sigma = g.norm();
+      if (sigma > o.rank_abs_tol) {
+        rho = 1;
+        ws.min_pivot = std::min(ws.min_pivot, sigma);
+        nd.Gpinv = g.transpose() / (sigma * sigma);
+        nd.V2.resize(1, 0);
+        if (nK > 1) {
+          KVec u = g / sigma;
+          u[0] += u[0] >= 0 ? 1.0 : -1.0;
+          SmallMat H = SmallMat::Identity(nK, nK);
+          H.noalias() -= (2.0 / u.squaredNorm()) * u * u.transpose();
+          nd.U2 = H.rightCols(nK - 1);
+        } else {
+          nd.U2.resize(1, 0);
+        }
+      } else {
+        nd.U2.setIdentity(nK, nK);
+        nd.V2.setIdentity(1, 1);
+      }
+    } else if (nK > 0 && nv > 0) {
       const SmallMat G = nd.K * j.S;
       ws.svd.compute(G, Eigen::ComputeFullU | Eigen::ComputeFullV);
       const auto& s = ws.svd.singularValues();
