@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
   csv << "scene,method,setting,steps,wall_per_sim_second,state_error,energy_drift,residual\n";
 
   const double T = 2.0;
+  std::string scene_names;
   for (const std::string& path : scenes) {
     Scene scene;
     try {
@@ -95,6 +96,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     const std::string name = std::filesystem::path(path).stem();
+    scene_names += (scene_names.empty() ? "" : " ") + name;
     const Run ref = simulate(scene, IntegratorType::DormandPrince54, 1e-3, 1e-14, T,
                              Formulation::Multipliers, true);
     std::cout << name << ": reference dopri5 tol 1e-14, " << ref.steps << " steps\n";
@@ -137,14 +139,17 @@ int main(int argc, char** argv) {
   if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
     const std::string plot = out_dir + "/speed_error.gp";
     std::ofstream gp(plot);
-    gp << "set datafile separator ','\nset terminal pngcairo size 900,600\n"
+    gp << "set datafile separator ','\nset terminal pngcairo size 1100,600 noenhanced\n"
        << "set output '" << out_dir << "/speed_error.png'\n"
        << "set logscale xy\nset format y '10^{%L}'\nset format x '10^{%L}'\n"
        << "set xlabel 'wall time per simulated second [s]'\n"
-       << "set ylabel 'max state error at t = 2 s'\nset key top right\nset grid\n"
+       << "set ylabel 'max state error at t = 2 s'\nset key outside right\nset grid\n"
        << "set title 'appell: speed against error (tree solver, projection on)'\n"
-       << "plot for [m in 'euler rk4 dopri5'] '" << out_dir
-       << "/speed_error.csv' using (strcol(2) eq m ? $5 : 1/0):6 with linespoints title m\n";
+       << "scenes = '" << scene_names << "'\nmethods = 'euler rk4 dopri5'\n"
+       << "plot for [i=1:words(scenes)*3] '" << out_dir << "/speed_error.csv' using "
+       << "((strcol(1) eq word(scenes, (i-1)/3+1) && strcol(2) eq word(methods, (i-1)%3+1)) ? $5 : 1/0):6 "
+       << "with linespoints lc (i-1)%3+1 pt (i-1)/3+4 "
+       << "title word(methods, (i-1)%3+1).' / '.word(scenes, (i-1)/3+1)\n";
     gp.close();
     if (std::system(("gnuplot " + plot).c_str()) == 0)
       std::cout << "figure: " << out_dir << "/speed_error.png\n";
