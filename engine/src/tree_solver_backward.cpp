@@ -31,15 +31,20 @@ void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
     B.row(r) *= cp.E[r];
   }
   ws.qr.compute(B);
-  const auto& R = ws.qr.matrixR();
+  const auto& R = ws.qr.matrixQR();
   const int diag = std::min(nb, 6);
   const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * std::abs(R(0, 0)));
   int rank = 0;
   while (rank < diag && std::abs(R(rank, rank)) > thr) ++rank;
   cp.rank = rank;
-  cp.Q = ws.qr.householderQ();
-  out.resize(rank, 6);
-  out.noalias() = cp.Q.leftCols(rank).transpose() * B;
+  cp.qr = R;
+  cp.hc.head(diag) = ws.qr.hCoeffs();
+  // Q₁ᵀ E B = R₁ Πᵀ (B Π = Q R): the kept rows are R's upper rows with the
+  // column pivoting undone — no product with Q needed.
+  const auto& perm = ws.qr.colsPermutation().indices();
+  out.setZero(rank, 6);
+  for (int c = 0; c < 6; ++c)
+    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, perm[c]) = R(r, c);
 }
 
 /// Body rows of a constraint block, world covectors → body frame (adjoint of
@@ -51,6 +56,48 @@ void bodyRows(const Data& data, const ConstraintData& cdata, TreeBlock& tb) {
   tb.Kbody.resize(tb.rows, 6);
   for (int r = 0; r < tb.rows; ++r)
     tb.Kbody.row(r) = oMi.actInvForce(tb.sign * W.row(r).transpose()).transpose();
+}
+
+/// out += Xᵀ H X with X = ᵖXᵢ (motion, parent → child) of M = liMi, i.e.
+/// out += F H Fᵀ with the force transform F = [R, p̂R; 0, R] — done blockwise
+/// (rotate the 3×3 blocks, then shear by p̂), about half the work of two dense
+/// 6×6 products and no 6×6 transform to build. H need not be symmetric.
+void addCongruence(const SE3& M, const Mat6& H, Mat6& out) {
+  const Mat3& R = M.R;
+  const Mat3 A = R * H.topLeftCorner<3, 3>() * R.transpose();
+  const Mat3 B = R * H.topRightCorner<3, 3>() * R.transpose();
+  const Mat3 C = R * H.bottomLeftCorner<3, 3>() * R.transpose();
+  const Mat3 D = R * H.bottomRightCorner<3, 3>() * R.transpose();
+  const Mat3 ph = skew(M.p);
+  const Mat3 Bt = B + ph * D;  // top-right of T H' Tᵀ, T = [1, p̂; 0, 1]
+  out.topRightCorner<3, 3>() += Bt;
+  out.bottomLeftCorner<3, 3>().noalias() += C - D * ph;
+  out.bottomRightCorner<3, 3>() += D;
+  out.topLeftCorner<3, 3>().noalias() += A + ph * C - Bt * ph;
+}
+
+/// Split of a free joint (S = 1, so G = K) without an SVD. The compression
+/// left K (nK ≤ 6 rows) independent; Kᵀ = Q R (Householder) gives
+/// G⁺ = Q₁ R⁻ᵀ, V₂ = Q₂ and no rows to hand up. 1/‖R⁻¹‖_F ≤ σ_min(K) ≤
+/// √nK/‖R⁻¹‖_F, so when that lower bound is above the first refinement
+/// threshold (5·10⁻², far above the rank tolerances: ‖K‖ ≤ √12) the rank is
+/// full and the refinement decision is the SVD's; otherwise returns false
+/// and the caller takes the SVD.
+bool freeSplit(TreeWorkspace& ws, Node& nd) {
+  const int nK = nd.nK;
+  ws.qrT.compute(nd.K.transpose());
+  const Mat6 Q = ws.qrT.householderQ();
+  const auto R = ws.qrT.matrixQR().topRows(nK).template triangularView<Eigen::Upper>();
+  // Gpinvᵀ = R⁻¹ Q₁ᵀ.
+  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> Gt = Q.leftCols(nK).transpose();
+  R.solveInPlace(Gt);
+  const double lb = 1.0 / Gt.norm();  // ‖R⁻¹ Q₁ᵀ‖_F = ‖R⁻¹‖_F
+  if (!(lb > 5e-2)) return false;
+  ws.min_pivot = std::min(ws.min_pivot, lb);
+  nd.Gpinv = Gt.transpose();
+  nd.U2.resize(nK, 0);
+  nd.V2 = Q.rightCols(6 - nK);
+  return true;
 }
 
 }  // namespace
@@ -138,6 +185,8 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
         nd.U2.setIdentity(nK, nK);
         nd.V2.setIdentity(1, 1);
       }
+    } else if (nK > 0 && j.type == JointType::Floating && freeSplit(ws, nd)) {
+      rho = nK;
     } else if (nK > 0 && nv > 0) {
       const SmallMat G = nd.K * j.S;
       ws.svd.compute(G, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -176,9 +225,12 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
     //    part z is eliminated as in ABA, and the parent sees Pᵀ Ia P — the
     //    particular/free coupling the constrained-LQR equations drop.
+    // GK = G⁺ K (nv × 6): P = 1 − S GK is a rank-ρ update of the identity.
+    Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;
     if (rho > 0) {
+      GK.noalias() = nd.Gpinv * nd.K;
       nd.P.setIdentity();
-      nd.P.noalias() -= j.S * (nd.Gpinv * nd.K);
+      nd.P.noalias() -= j.S * GK;
       nd.S2.noalias() = j.S * nd.V2;
     } else {
       nd.S2 = j.S;
@@ -190,14 +242,23 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
       nd.Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
     }
-    if (rho > 0)
+    if (rho > 0 && nv <= 2) {
+      // Pᵀ Ia P = Ia P − GKᵀ (Sᵀ Ia P), Ia P = Ia − (Ia S) GK: O(36 nv) per
+      // factor instead of two dense 6 × 6 products.
+      Mat6X IaS(6, nv);
+      IaS.noalias() = nd.Ia * j.S;
+      Mat6 IaP = nd.Ia;
+      IaP.noalias() -= IaS * GK;
+      Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> SIaP(nv, 6);
+      SIaP.noalias() = j.S.transpose() * IaP;
+      nd.H = IaP;
+      nd.H.noalias() -= GK.transpose() * SIaP;
+    } else if (rho > 0) {
       nd.H.noalias() = nd.P.transpose() * nd.Ia * nd.P;
-    else
+    } else {
       nd.H = nd.Ia;
-    if (p >= 0) {
-      const Mat6 X = data.liMi[i].toInverseMotionMatrix();
-      ws.nodes[p].IA.noalias() += X.transpose() * nd.H * X;
     }
+    if (p >= 0) addCongruence(data.liMi[i], nd.H, ws.nodes[p].IA);
   }
 }
 
@@ -227,8 +288,8 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
         off += g.rows;
       }
       r.array() *= cp.E.array();
-      BufVec t(cp.nrows);
-      t.noalias() = cp.Q.transpose() * r;
+      BufVec t = r;
+      applyQt(cp, t);
       cp.rhs = t.head(cp.rank);
       if (check && cp.nrows > cp.rank) {
         // The dropped rows are combinations of the kept ones: their right

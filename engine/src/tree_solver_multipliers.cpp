@@ -39,8 +39,9 @@ void unrollNode(TreeWorkspace& ws, int body, int from, VecX& lambda) {
   Node& nd = ws.nodes[body];
   for (int e = from; e >= 0; --e) {
     const Compression& cp = nd.comp[e];
-    BufVec lam(cp.nrows);
-    lam.noalias() = cp.Q.leftCols(cp.rank) * cp.mu;
+    BufVec lam = BufVec::Zero(cp.nrows);
+    lam.head(cp.rank) = cp.mu;
+    applyQ(cp, lam);
     lam.array() *= cp.E.array();
     distribute(ws, nd, e, lam, lambda);
   }
@@ -103,8 +104,10 @@ std::string describeFailure(const Model& model, const Data& data, TreeWorkspace&
       off += g.rows;
     }
     r.array() *= cp.E.array();
-    const BufVec t = cp.Q.transpose() * r;
-    BufVec lam = cp.Q.rightCols(cp.nrows - cp.rank) * t.tail(cp.nrows - cp.rank);
+    BufVec lam = r;
+    applyQt(cp, lam);
+    lam.head(cp.rank).setZero();  // Q₂ t₂: the dropped combinations only
+    applyQ(cp, lam);
     lam.array() *= cp.E.array();
     distribute(ws, nd, f.comp, lam, cert);
     if (f.comp > 0) unrollNode(ws, i, f.comp - 1, cert);

@@ -9,6 +9,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
@@ -32,10 +33,14 @@ struct Segment {
 };
 
 /// One rank-revealing compression  Qᵀ E [stacked rows] = [K; ≈0].
+/// Q = H₀ H₁ ⋯ is kept as its Householder reflectors (as the QR left them:
+/// essential parts below the diagonal of `qr`, scalars in `hc`); applying
+/// them costs O(nrows · 6) per vector where forming Q costs O(nrows² · 6).
 struct Compression {
   int nrows = 0;               ///< rows stacked
   int rank = 0;                ///< rows kept
-  BufMat Q;                    ///< nrows × nrows orthogonal factor
+  BufRows qr;                  ///< nrows × 6, reflectors below the diagonal
+  Eigen::Matrix<double, 6, 1> hc;  ///< reflector scalars τ (min(nrows, 6) used)
   BufVec E;                    ///< row equilibration scales
   int nseg = 0;
   std::array<Segment, 13> seg;
@@ -62,6 +67,24 @@ struct LoopRow {
   bool joint_space = false;
   int bodyA = -1, bodyB = -1;
 };
+
+/// x ← Qᵀ x (x has cp.nrows entries): H₀ first.
+inline void applyQt(const Compression& cp, BufVec& x) {
+  const int nh = std::min(cp.nrows, 6);
+  double ws = 0;
+  for (int k = 0; k < nh; ++k)
+    x.tail(cp.nrows - k)
+        .applyHouseholderOnTheLeft(cp.qr.col(k).tail(cp.nrows - k - 1), cp.hc[k], &ws);
+}
+
+/// x ← Q x (x has cp.nrows entries): the last reflector first.
+inline void applyQ(const Compression& cp, BufVec& x) {
+  const int nh = std::min(cp.nrows, 6);
+  double ws = 0;
+  for (int k = nh - 1; k >= 0; --k)
+    x.tail(cp.nrows - k)
+        .applyHouseholderOnTheLeft(cp.qr.col(k).tail(cp.nrows - k - 1), cp.hc[k], &ws);
+}
 
 struct Node {
   std::vector<Segment> groups;            ///< own blocks, then children
@@ -117,6 +140,7 @@ struct TreeWorkspace {
   // Solver scratch with compile-time maximum sizes.
   Eigen::ColPivHouseholderQR<BufRows> qr;
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
+  Eigen::HouseholderQR<Mat6X> qrT;        ///< Kᵀ of a free joint (S = 1)
   BufRows buf;
   BufVec bufE;
 
