@@ -225,12 +225,11 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
     //    part z is eliminated as in ABA, and the parent sees Pᵀ Ia P — the
     //    particular/free coupling the constrained-LQR equations drop.
-    // GK = G⁺ K (nv × 6): P = 1 − S GK is a rank-ρ update of the identity.
-    Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;
+    // GK = G⁺ K (nv × 6): P = 1 − S GK is a low-rank update of the identity,
+    // never formed when nv ≤ 2 (applied as x − GKᵀ(Sᵀx) / x − S(GK x)).
+    auto& GK = nd.GK;
     if (rho > 0) {
       GK.noalias() = nd.Gpinv * nd.K;
-      nd.P.setIdentity();
-      nd.P.noalias() -= j.S * GK;
       nd.S2.noalias() = j.S * nd.V2;
     } else {
       nd.S2 = j.S;
@@ -254,7 +253,9 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       nd.H = IaP;
       nd.H.noalias() -= GK.transpose() * SIaP;
     } else if (rho > 0) {
-      nd.H.noalias() = nd.P.transpose() * nd.Ia * nd.P;
+      Mat6 P = Mat6::Identity();
+      P.noalias() -= j.S * GK;
+      nd.H.noalias() = P.transpose() * nd.Ia * P;
     } else {
       nd.H = nd.Ia;
     }
@@ -323,7 +324,13 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
       //   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ.
       Vec6 g = ws.use_c ? Vec6(nd.H * nd.c) : Vec6::Zero();
       if (nd.rankG > 0) {
-        g.noalias() += nd.P.transpose() * (nd.Ia * d + pa);
+        // Pᵀ x = x − GKᵀ (Sᵀ x)
+        Vec6 x = pa;
+        x.noalias() += nd.Ia * d;
+        KVec sx(j.nv);
+        sx.noalias() = j.S.transpose() * x;
+        g += x;
+        g.noalias() -= nd.GK.transpose() * sx;
         g.noalias() += nd.K.transpose() * (nd.Gpinv.transpose() * tau);
       } else {
         g += pa;

@@ -102,7 +102,7 @@ struct Node {
   SmallMat V2;                            ///< nv × nf, right null space of K S
   KRows Kpass;                            ///< U2ᵀ K, this body's frame
   KRows KpassParent;                      ///< the same covectors in the parent's frame
-  Mat6 P;                                 ///< 1 − S G⁺ K
+  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK
   Mat6X S2, U;                            ///< S V2 and IA S V2
   SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
   Mat6 Ia;                                ///< IA − U D⁻¹ Uᵀ
