@@ -114,9 +114,10 @@ TEST(IoErrors, InitialStateViolatesTheConstraints) {
   EXPECT_NE(msg.find("0.4"), std::string::npos) << msg;
 }
 
-TEST(IoErrors, TerrainMeshIsDeclaredButNotSupportedYet) {
-  expectError("terrain.urdf", 5, {"<support name=\"hills\">", "terrain meshes not supported yet",
-                                  "12 triangles"});
+TEST(IoErrors, TerrainMeshWithADegenerateTriangle) {
+  // Terrains load now (tests/test_contact_terrain.cpp); a bad mesh names its triangle.
+  expectError("../../terrain/degenerate.urdf", 5,
+              {"<support name=\"hills\">", "triangle 1", "is degenerate", "degenerate.obj"});
 }
 
 TEST(IoErrors, MissingFile) {

@@ -1,6 +1,7 @@
 // Dispatch over the support surface, and the pieces every pair shares:
 // the contact point from the Gauss map and the tangent frame with its rates.
 #include "geometry_internal.hpp"
+#include "terrain_index.hpp"
 
 namespace appell {
 
@@ -59,6 +60,10 @@ void contactGeometry(const Shape& shape, const SupportSurface& surface,
                  [&](const SphereSurface& s) {
                    detail::sphereSurfaceGeometry(shape, s, support, body_pose, body_velocity, out,
                                                  options);
+                 },
+                 [&](const TerrainMesh& t) {
+                   detail::terrainGeometry(shape, t, support, body_pose, body_velocity, out,
+                                           options);
                  }},
              surface);
 }

@@ -80,6 +80,9 @@ ShapeContact::ShapeContact(ContactKind kind, int body, Shape shape, Support supp
     fail(e.what());
   }
   if (auto* p = std::get_if<Plane>(&support_.surface)) p->normal.normalize();
+  // Face normals, adjacency and the box tree, once (evaluation must not allocate).
+  if (auto* t = std::get_if<TerrainMesh>(&support_.surface); t && !t->index)
+    *t = makeTerrain(t->vertices, t->triangles);
   std::string why;
   switch (kind) {
     case ContactKind::Rolling:

@@ -99,6 +99,13 @@ void validateSupport(const Support& support) {
                           if (!s.centre.allFinite()) fail(support, "sphere centre must be finite");
                           if (!std::isfinite(s.radius) || s.radius <= 0)
                             fail(support, "sphere radius must be positive and finite");
+                        },
+                        [&](const TerrainMesh& t) {
+                          try {
+                            validateTerrain(t);
+                          } catch (const std::invalid_argument& e) {
+                            fail(support, e.what());
+                          }
                         }},
              support.surface);
   std::visit(Overloaded{[&](const StaticMotion& m) {

@@ -125,17 +125,17 @@ void setJointState(const XmlSource& src, const Model& model, const JointStateDec
 void buildSceneContents(const XmlSource& src, const AppellBlock& block, Scene& scene) {
   const Model& model = scene.model;
   for (const SupportDecl& d : block.supports) {
-    if (d.terrain)
-      fail(src, d.element,
-           "terrain meshes not supported yet: the contacts module has no mesh-terrain surface "
-           "(the mesh " + d.terrain_path + " itself was read: " +
-               std::to_string(d.terrain_mesh->triangles.size()) + " triangles)");
+    Support support = d.support;
     try {
-      validateSupport(d.support);
+      // Checks the triangles (degenerate ones name their index) and builds the index.
+      if (d.terrain)
+        support.surface = makeTerrain(d.terrain_mesh->vertices, d.terrain_mesh->triangles);
+      validateSupport(support);
     } catch (const std::invalid_argument& e) {
-      fail(src, d.element, e.what());
+      fail(src, d.element,
+           d.terrain ? std::string(e.what()) + " (in " + d.terrain_path + ")" : e.what());
     }
-    scene.supports.push_back(d.support);
+    scene.supports.push_back(std::move(support));
   }
   for (const ContactDecl& c : block.contacts) {
     ContactInfo info;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <appell/spatial.hpp>
+#include <appell/terrain.hpp>
 
 #include <functional>
 #include <string>
@@ -32,7 +33,8 @@ struct SphereSurface {
   Side side = Side::Inside;
 };
 
-using SupportSurface = std::variant<Plane, SphereSurface>;
+/// TerrainMesh: a triangle mesh, piecewise planar (terrain.hpp).
+using SupportSurface = std::variant<Plane, SphereSurface, TerrainMesh>;
 
 /// Pose, velocity and acceleration of the support frame at one instant (world).
 struct SupportState {

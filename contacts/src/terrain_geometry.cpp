@@ -1,0 +1,147 @@
+// A smooth shape on a terrain mesh: the plane contact with the face that holds
+// its contact point (terrain.hpp states the model).
+#include "geometry_internal.hpp"
+#include "terrain_index.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace appell::detail {
+
+namespace {
+
+// Barycentric coordinates of p in face f (support frame), from signed areas
+// along the face normal.
+Vec3 barycentric(const TerrainMesh& t, const TerrainIndex& idx, int f, const Vec3& p) {
+  const auto& tri = t.triangles[f];
+  const Vec3& a = t.vertices[tri[0]];
+  const Vec3& b = t.vertices[tri[1]];
+  const Vec3& c = t.vertices[tri[2]];
+  const Vec3& n = idx.normal[f];
+  const double area = n.dot((b - a).cross(c - a));
+  return Vec3(n.dot((b - p).cross(c - p)), n.dot((c - p).cross(a - p)),
+              n.dot((a - p).cross(b - p))) /
+         area;
+}
+
+constexpr double kInsideTol = 1e-9;
+
+// Reason text naming the edge or vertex; a per-thread buffer so that setting
+// it does not allocate (valid until this thread's next terrain query).
+const char* edgeReason(const TerrainMesh& t, const TerrainIndex& idx, int f, const Vec3& lambda) {
+  thread_local char text[200];
+  int negative = 0, k_neg = 0, k_pos = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (lambda(k) < -kInsideTol) {
+      ++negative;
+      k_neg = k;
+    } else {
+      k_pos = k;
+    }
+  }
+  if (negative == 1) {
+    const int j = idx.neighbour[f][k_neg];
+    if (j >= 0)
+      std::snprintf(text, sizeof text,
+                    "contact on a terrain edge between faces %d and %d (no face holds the contact "
+                    "point; the surface has no tangent plane there)",
+                    f, j);
+    else
+      std::snprintf(text, sizeof text,
+                    "contact beyond the terrain's boundary edge of face %d (vertices %d, %d)", f,
+                    t.triangles[f][(k_neg + 1) % 3], t.triangles[f][(k_neg + 2) % 3]);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "contact on terrain vertex %d (corner of face %d; no face holds the contact "
+                  "point)",
+                  t.triangles[f][k_pos], f);
+  }
+  return text;
+}
+
+}  // namespace
+
+void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const SupportState& S,
+                     const SE3& pose, const Vec6& V, ContactGeometry& out,
+                     const GeometryOptions& opt) {
+  if (!terrain.index) {
+    out = ContactGeometry{};
+    markSingular(out, "terrain index not built (create the mesh with makeTerrain)");
+    return;
+  }
+  const TerrainIndex& idx = *terrain.index;
+
+  // Box of the body in the support frame from its extreme points along the
+  // support axes, grown by half its largest side: every face whose plane
+  // contact lies within that margin of the body overlaps it.
+  const SE3 inv = S.pose.inverse();
+  Vec3 lo, hi;
+  for (int i = 0; i < 3; ++i) {
+    for (int s = -1; s <= 1; s += 2) {
+      const Vec3 d = S.pose.R.col(i) * static_cast<double>(s);
+      const GaussPoint g = inverseGaussMap(shape, pose.R.transpose() * d, opt.singular_tol);
+      const double x = inv.apply(pose.apply(g.y))(i);
+      if (s < 0) lo(i) = x;
+      else hi(i) = x;
+    }
+  }
+  const double margin = 0.5 * (hi - lo).maxCoeff() + 1e-9;
+  lo.array() -= margin;
+  hi.array() += margin;
+
+  ContactGeometry trial;
+  int best = -1, nearest = -1;
+  double nearest_gap = INFINITY;  // the ranking score below
+  Vec3 nearest_lambda = Vec3::Zero();
+  auto consider = [&](int f) {
+    Plane plane;
+    plane.point = terrain.vertices[terrain.triangles[f][0]];
+    plane.normal = idx.normal[f];
+    trial.singular = false;
+    trial.reason = nullptr;
+    planeGeometry(shape, plane, S, pose, V, trial, opt);
+    const Vec3 foot = inv.apply(trial.support_point);
+    const Vec3 lambda = barycentric(terrain, idx, f, foot);
+    if (lambda.minCoeff() >= -kInsideTol) {
+      if (best < 0 || trial.gap < out.gap) {
+        best = f;
+        out = trial;
+      }
+    } else if (best < 0) {
+      // Rank the faces that do not hold the point by |gap| plus how far the
+      // foot lies outside the triangle (max over edges of −λ_k times the
+      // altitude onto edge k): the face the body is over names the edge.
+      const auto& tri = terrain.triangles[f];
+      const double area2 = std::abs(
+          idx.normal[f].dot((terrain.vertices[tri[1]] - terrain.vertices[tri[0]])
+                                .cross(terrain.vertices[tri[2]] - terrain.vertices[tri[0]])));
+      double outside = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double edge =
+            (terrain.vertices[tri[(k + 2) % 3]] - terrain.vertices[tri[(k + 1) % 3]]).norm();
+        outside = std::max(outside, -lambda(k) * area2 / edge);
+      }
+      const double score = std::abs(trial.gap) + outside;
+      if (score >= nearest_gap) return;
+      nearest = f;
+      nearest_gap = score;
+      nearest_lambda = lambda;
+      out = trial;  // finite values to leave if no face holds the point
+    }
+  };
+  detail::forEachFaceInBox(idx, lo, hi, consider);
+  // A holding face farther than the margin (a body high above the terrain)
+  // lies outside the box: fall back to every face.
+  if (best < 0 || out.gap > margin) {
+    for (int f = 0; f < static_cast<int>(terrain.triangles.size()); ++f) consider(f);
+  }
+  if (best >= 0) return;
+  if (nearest < 0) {
+    markSingular(out, "no terrain face near the body");
+    return;
+  }
+  markSingular(out, edgeReason(terrain, idx, nearest, nearest_lambda));
+}
+
+}  // namespace appell::detail
