@@ -68,22 +68,29 @@ struct LoopRow {
   int bodyA = -1, bodyB = -1;
 };
 
+/// x ← H_k x, H_k = 1 − τ v vᵀ with v = [0…0, 1, essential] (reflector k of
+/// the compression's QR, Eigen's storage). Written out: Eigen's generic
+/// applyHouseholderOnTheLeft costs several times more on these short vectors.
+inline void applyReflector(const Compression& cp, int k, BufVec& x) {
+  const double tau = cp.hc[k];
+  if (tau == 0) return;
+  double t = x[k];
+  for (int r = k + 1; r < cp.nrows; ++r) t += cp.qr(r, k) * x[r];
+  t *= tau;
+  x[k] -= t;
+  for (int r = k + 1; r < cp.nrows; ++r) x[r] -= t * cp.qr(r, k);
+}
+
 /// x ← Qᵀ x (x has cp.nrows entries): H₀ first.
 inline void applyQt(const Compression& cp, BufVec& x) {
   const int nh = std::min(cp.nrows, 6);
-  double ws = 0;
-  for (int k = 0; k < nh; ++k)
-    x.tail(cp.nrows - k)
-        .applyHouseholderOnTheLeft(cp.qr.col(k).tail(cp.nrows - k - 1), cp.hc[k], &ws);
+  for (int k = 0; k < nh; ++k) applyReflector(cp, k, x);
 }
 
 /// x ← Q x (x has cp.nrows entries): the last reflector first.
 inline void applyQ(const Compression& cp, BufVec& x) {
   const int nh = std::min(cp.nrows, 6);
-  double ws = 0;
-  for (int k = nh - 1; k >= 0; --k)
-    x.tail(cp.nrows - k)
-        .applyHouseholderOnTheLeft(cp.qr.col(k).tail(cp.nrows - k - 1), cp.hc[k], &ws);
+  for (int k = nh - 1; k >= 0; --k) applyReflector(cp, k, x);
 }
 
 struct Node {
