@@ -20,7 +20,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <new>
@@ -75,6 +77,7 @@ void compareWithPlane(const Plane& plane, const TerrainMesh& terrain, const Supp
                       unsigned seed, int& compared) {
   std::mt19937 rng(seed);
   compared = 0;
+  double worst = 0;
   for (const ShapeCase& sc : shapeCases()) {
     if (!std::holds_alternative<Sphere>(sc.shape) && !std::holds_alternative<Disk>(sc.shape) &&
         !std::holds_alternative<Ellipsoid>(sc.shape))
@@ -102,10 +105,15 @@ void compareWithPlane(const Plane& plane, const TerrainMesh& terrain, const Supp
         EXPECT_LT((a.frame.point - b.frame.point).norm(), 1e-12);
         EXPECT_LT((a.frame.normal - b.frame.normal).norm(), 1e-12);
         EXPECT_NEAR(a.frame.gap, b.frame.gap, 1e-12);
+        worst = std::max({worst, (a.Wa - b.Wa).cwiseAbs().maxCoeff(),
+                          (a.b - b.b).cwiseAbs().maxCoeff(),
+                          (a.kappa - b.kappa).cwiseAbs().maxCoeff(),
+                          (a.gap - b.gap).cwiseAbs().maxCoeff()});
         ++compared;
       }
     }
   }
+  std::printf("  %d states, max |Δ| over Wa, b, κ, gap = %.3g\n", compared, worst);
 }
 
 SinusoidalTiltMotion tilting() {
@@ -249,6 +257,8 @@ TEST(ContactTerrain, BallRollsDownARampFaceWithTheAnalyticAcceleration) {
   const double s = 0.5 * (5.0 / 7.0) * g * std::sin(kSlope) * T * T;
   EXPECT_LT((q.head<3>() - (c0 + s * down)).norm(), 1e-9) << q.head<3>().transpose();
   EXPECT_LT(std::abs(sim.energy(q, v) - E0), 1e-10 * std::abs(E0) + 1e-12);
+  std::printf("  ramp: |c − c_analytic| = %.3g m, |ΔE| = %.3g J after %.1f s\n",
+              (q.head<3>() - (c0 + s * down)).norm(), std::abs(sim.energy(q, v) - E0), T);
   RowBlock rows;
   const auto& contact = static_cast<const ShapeContact&>(*sim.list[0]);
   SE3 pose;
@@ -275,6 +285,7 @@ TEST(ContactTerrain, RollingOverTheCreaseIsReportedSingular) {
     sim.step(t, q, v, dt);
   }
   ASSERT_TRUE(sim.saw_singular);
+  std::printf("  singular at t = %.3f, x = %.4f: %s\n", t, q[0], sim.reason.c_str());
   // The flat face holds the contact point up to the crease x = 0; on the ramp
   // it is held from x = r tan α: in between, the ball is on the edge.
   EXPECT_GT(q[0], -0.01);
@@ -405,6 +416,8 @@ TEST(ContactTerrain, UrdfTerrainFromAnStlLoadsAndRuns) {
   const double s = 0.5 * (5.0 / 7.0) * 9.81 * std::sin(kSlope) * T * T;
   EXPECT_LT((sim.q().head<3>() - (c0 + s * down)).norm(), 1e-8) << sim.q().head<3>().transpose();
   EXPECT_LT(std::abs(sim.energy() - E0), 1e-9);
+  std::printf("  urdf: |c − c_analytic| = %.3g m, |ΔE| = %.3g J after %.1f s\n",
+              (sim.q().head<3>() - (c0 + s * down)).norm(), std::abs(sim.energy() - E0), T);
   EXPECT_LT((sim.contactFrame(0).normal - n).norm(), 1e-12);
 }
 
