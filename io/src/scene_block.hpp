@@ -11,7 +11,7 @@ namespace appell::io {
 struct SupportDecl {
   const TiXmlElement* element = nullptr;
   std::string name;
-  bool terrain = false;            ///< a terrain mesh (surface not available in contacts yet)
+  bool terrain = false;            ///< a terrain mesh (buildSceneContents turns it into a TerrainMesh surface)
   Support support;                 ///< when !terrain
   std::shared_ptr<const TriangleMesh> terrain_mesh;
   std::string terrain_path;
