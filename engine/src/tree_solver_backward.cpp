@@ -15,6 +15,25 @@ namespace appell::detail {
 
 namespace {
 
+/// Rank decision and storage of a finished compression QR: keeps rows whose
+/// |R_ii| exceeds max(abs, rel·|R_00|), stores the reflectors, and sets
+/// out = Q₁ᵀ E B = R₁ Πᵀ (B Π = Q R) — no product with Q needed.
+template <class QR>
+void takeQR(const QR& qr, int nb, const SolverOptions& o, Compression& cp, KRows& out) {
+  const auto& R = qr.matrixQR();
+  const int diag = std::min(nb, 6);
+  const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * std::abs(R(0, 0)));
+  int rank = 0;
+  while (rank < diag && std::abs(R(rank, rank)) > thr) ++rank;
+  cp.rank = rank;
+  cp.qr = R;
+  cp.hc.head(diag) = qr.hCoeffs();
+  const auto& perm = qr.colsPermutation().indices();
+  out.setZero(rank, 6);
+  for (int c = 0; c < 6; ++c)
+    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, perm[c]) = R(r, c);
+}
+
 /// Rank-revealing compression of the first `nb` rows of ws.buf:
 /// equilibrate each row (rows already below the absolute tolerance are left
 /// alone, so round-off residue of a redundant row is never blown up into a
@@ -30,21 +49,18 @@ void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
     cp.E[r] = n > o.rank_abs_tol ? 1.0 / n : 1.0;
     B.row(r) *= cp.E[r];
   }
-  ws.qr.compute(B);
-  const auto& R = ws.qr.matrixQR();
-  const int diag = std::min(nb, 6);
-  const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * std::abs(R(0, 0)));
-  int rank = 0;
-  while (rank < diag && std::abs(R(rank, rank)) > thr) ++rank;
-  cp.rank = rank;
-  cp.qr = R;
-  cp.hc.head(diag) = ws.qr.hCoeffs();
-  // Q₁ᵀ E B = R₁ Πᵀ (B Π = Q R): the kept rows are R's upper rows with the
-  // column pivoting undone — no product with Q needed.
-  const auto& perm = ws.qr.colsPermutation().indices();
-  out.setZero(rank, 6);
-  for (int c = 0; c < 6; ++c)
-    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, perm[c]) = R(r, c);
+  // Few rows (the common case: one contact's 1–3 rows plus a child's): a
+  // fixed-size QR, which Eigen unrolls, is several times cheaper than the
+  // ≤ 12-row dynamic one; same algorithm, same pivots.
+  switch (nb) {
+    case 1: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 1, 6>>(B), nb, o, cp, out); break;
+    case 2: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 2, 6>>(B), nb, o, cp, out); break;
+    case 3: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 3, 6>>(B), nb, o, cp, out); break;
+    case 4: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 4, 6>>(B), nb, o, cp, out); break;
+    case 5: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 5, 6>>(B), nb, o, cp, out); break;
+    case 6: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 6, 6>>(B), nb, o, cp, out); break;
+    default: ws.qr.compute(B); takeQR(ws.qr, nb, o, cp, out);
+  }
 }
 
 /// Body rows of a constraint block, world covectors → body frame (adjoint of
