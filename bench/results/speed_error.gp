@@ -1,0 +1,14 @@
+set datafile separator ','
+set terminal pngcairo size 1100,600 noenhanced
+set output 'bench/results/speed_error.png'
+set logscale xy
+set format y '10^{%L}'
+set format x '10^{%L}'
+set xlabel 'wall time per simulated second [s]'
+set ylabel 'max state error at t = 2 s'
+set key outside right
+set grid
+set title 'appell: speed against error (tree solver, projection on)'
+scenes = 'rolling_disk sleigh hemisphere_bowl'
+methods = 'euler rk4 dopri5'
+plot for [i=1:words(scenes)*3] 'bench/results/speed_error.csv' using ((strcol(1) eq word(scenes, (i-1)/3+1) && strcol(2) eq word(methods, (i-1)%3+1)) ? $5 : 1/0):6 with linespoints lc (i-1)%3+1 pt (i-1)/3+4 title word(methods, (i-1)%3+1).' / '.word(scenes, (i-1)/3+1)
