@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
     std::ofstream gp(plot);
     gp << "set datafile separator ','\nset terminal pngcairo size 1100,600 noenhanced\n"
        << "set output '" << out_dir << "/speed_error.png'\n"
-       << "set logscale xy\nset format y '10^{%L}'\nset format x '10^{%L}'\n"
+       << "set logscale xy\nset format y '1e%L'\nset format x '1e%L'\n"
        << "set xlabel 'wall time per simulated second [s]'\n"
        << "set ylabel 'max state error at t = 2 s'\nset key outside right\nset grid\n"
        << "set title 'appell: speed against error (tree solver, projection on)'\n"

@@ -2,8 +2,8 @@ set datafile separator ','
 set terminal pngcairo size 1100,600 noenhanced
 set output 'bench/results/speed_error.png'
 set logscale xy
-set format y '10^{%L}'
-set format x '10^{%L}'
+set format y '1e%L'
+set format x '1e%L'
 set xlabel 'wall time per simulated second [s]'
 set ylabel 'max state error at t = 2 s'
 set key outside right
