@@ -77,3 +77,15 @@ void operator delete(void* p, std::align_val_t) noexcept { __libc_free(p); }
 void operator delete[](void* p, std::align_val_t) noexcept { __libc_free(p); }
 void operator delete(void* p, size_t, std::align_val_t) noexcept { __libc_free(p); }
 void operator delete[](void* p, size_t, std::align_val_t) noexcept { __libc_free(p); }
+
+/// Allocations made by `fn` over `reps` calls, after one warm-up call (which may
+/// size workspaces).
+template <typename F>
+long allocationsIn(F&& fn, int reps = 20) {
+  fn();
+  g_allocations = 0;
+  g_counting = true;
+  for (int r = 0; r < reps; ++r) fn();
+  g_counting = false;
+  return g_allocations.load();
+}

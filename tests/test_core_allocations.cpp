@@ -22,17 +22,6 @@ using namespace appell;
 
 namespace {
 
-/// Allocations made by `fn` over `reps` calls, after one warm-up call.
-template <typename F>
-long allocationsIn(F&& fn, int reps = 20) {
-  fn();
-  g_allocations = 0;
-  g_counting = true;
-  for (int r = 0; r < reps; ++r) fn();
-  g_counting = false;
-  return g_allocations.load();
-}
-
 struct AbaField : AccelerationField {
   const Model& model;
   Data& data;

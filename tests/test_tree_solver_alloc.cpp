@@ -19,16 +19,6 @@ using namespace appell::test;
 
 namespace {
 
-template <typename F>
-long allocationsIn(F&& fn, int reps = 10) {
-  fn();
-  g_allocations = 0;
-  g_counting = true;
-  for (int r = 0; r < reps; ++r) fn();
-  g_counting = false;
-  return g_allocations.load();
-}
-
 void expectNoAllocation(System& s) {
   const ConstraintList list = s.list();
   Data data(s.model);

@@ -31,13 +31,7 @@ inline ScalingScene carRow(int n_cars) {
   ScalingScene s;
   s.name = "car_row";
   s.model = b.build();
-  for (int i = 0; i < s.model.nbodies; ++i) {
-    if (s.model.joints[i].type != JointType::Continuous) continue;
-    ContactOptions o;
-    o.name = "roll_" + s.model.body_names[i];
-    s.constraints.push_back(makeContact(ContactKind::Rolling, i,
-                                        Disk{R, Vec3::Zero(), Vec3::UnitY()}, groundSupport(), o));
-  }
+  addWheelContacts(s, R);
   s.q = neutralConfiguration(s.model);
   s.v = VecX::Zero(s.model.nv);
   for (size_t k = 0; k < chassis.size(); ++k) {

@@ -39,6 +39,18 @@ inline void setFreePose(VecX& q, int idx_q, const Vec3& p, double yaw) {
 
 inline Support groundSupport() { return Support{Plane{}, StaticMotion{}, "ground", -1}; }
 
+/// A rolling thin-disk contact (radius R, axle along the body's y) on every
+/// body attached by a continuous joint: the wheels of the scaling scenes.
+inline void addWheelContacts(ScalingScene& s, double R) {
+  for (int i = 0; i < s.model.nbodies; ++i) {
+    if (s.model.joints[i].type != JointType::Continuous) continue;
+    ContactOptions o;
+    o.name = "roll_" + s.model.body_names[i];
+    s.constraints.push_back(makeContact(ContactKind::Rolling, i,
+                                        Disk{R, Vec3::Zero(), Vec3::UnitY()}, groundSupport(), o));
+  }
+}
+
 inline ScalingScene nTrailer(int n_trailers) {
   const double L = 1.5, H = 0.4;  // hitch-to-axle length, body height of the frames
   ModelBuilder b;

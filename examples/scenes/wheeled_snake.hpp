@@ -31,13 +31,7 @@ inline ScalingScene wheeledSnake(int n_links) {
   ScalingScene s;
   s.name = "wheeled_snake";
   s.model = b.build();
-  for (int i = 0; i < s.model.nbodies; ++i) {
-    if (s.model.joints[i].type != JointType::Continuous) continue;
-    ContactOptions o;
-    o.name = "roll_" + s.model.body_names[i];
-    s.constraints.push_back(makeContact(ContactKind::Rolling, i,
-                                        Disk{R, Vec3::Zero(), Vec3::UnitY()}, groundSupport(), o));
-  }
+  addWheelContacts(s, R);
   s.q = neutralConfiguration(s.model);
   setFreePose(s.q, 0, Vec3(0, 0, R), 0.0);
   for (int i = 1; i < s.model.nbodies; ++i)
