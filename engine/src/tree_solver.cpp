@@ -66,7 +66,6 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
     nd.c.setZero();
     nd.a.setZero();
   }
-  ws.buf.resize(12, 6);
   ws.tau = VecX::Zero(model.nv);
   ws.a_world.setZero();
   ws.vdot = VecX::Zero(model.nv);

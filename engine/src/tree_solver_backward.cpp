@@ -15,52 +15,42 @@ namespace appell::detail {
 
 namespace {
 
-/// Rank decision and storage of a finished compression QR: keeps rows whose
-/// |R_ii| exceeds max(abs, rel·|R_00|), stores the reflectors, and sets
-/// out = Q₁ᵀ E B = R₁ Πᵀ (B Π = Q R) — no product with Q needed.
-template <class QR>
-void takeQR(const QR& qr, int nb, const SolverOptions& o, Compression& cp, KRows& out) {
-  const auto& R = qr.matrixQR();
-  const int diag = std::min(nb, 6);
-  const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * std::abs(R(0, 0)));
-  int rank = 0;
-  while (rank < diag && std::abs(R(rank, rank)) > thr) ++rank;
-  cp.rank = rank;
-  cp.qr = R;
-  cp.hc.head(diag) = qr.hCoeffs();
-  const auto& perm = qr.colsPermutation().indices();
-  out.setZero(rank, 6);
+/// Writes `rows` (r × 6) into rows at..at+r of the QR's stack.
+template <class Rows>
+void stackRows(PivotedQR& qr, int at, const Rows& rows) {
   for (int c = 0; c < 6; ++c)
-    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, perm[c]) = R(r, c);
+    for (int r = 0; r < rows.rows(); ++r) qr.a[c][at + r] = rows(r, c);
 }
 
-/// Rank-revealing compression of the first `nb` rows of ws.buf:
+/// Rank-revealing compression of the first `nb` rows stacked in ws.qr:
 /// equilibrate each row (rows already below the absolute tolerance are left
 /// alone, so round-off residue of a redundant row is never blown up into a
-/// fake constraint), then Householder QR with column pivoting, Qᵀ E B = R.
-/// Keeps rows whose |R_ii| exceeds max(abs, rel·|R_00|); out = Q₁ᵀ E B.
+/// fake constraint), then Householder QR with column pivoting, Qᵀ E B Π = R,
+/// stopped at the numerical rank (pivoted_qr.hpp). Keeps the reflectors and
+/// sets out = Q₁ᵀ E B = R₁ Πᵀ — read off R, no product with Q.
 void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
   const SolverOptions& o = ws.options;
+  PivotedQR& qr = ws.qr;
   cp.nrows = nb;
   cp.E.resize(nb);
-  auto B = ws.buf.topRows(nb);
   for (int r = 0; r < nb; ++r) {
-    const double n = B.row(r).norm();
-    cp.E[r] = n > o.rank_abs_tol ? 1.0 / n : 1.0;
-    B.row(r) *= cp.E[r];
+    double n2 = 0;
+    for (int c = 0; c < 6; ++c) n2 += qr.a[c][r] * qr.a[c][r];
+    const double n = std::sqrt(n2);
+    const double e = n > o.rank_abs_tol ? 1.0 / n : 1.0;
+    cp.E[r] = e;
+    for (int c = 0; c < 6; ++c) qr.a[c][r] *= e;
   }
-  // Few rows (the common case: one contact's 1–3 rows plus a child's): a
-  // fixed-size QR, which Eigen unrolls, is several times cheaper than the
-  // ≤ 12-row dynamic one; same algorithm, same pivots.
-  switch (nb) {
-    case 1: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 1, 6>>(B), nb, o, cp, out); break;
-    case 2: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 2, 6>>(B), nb, o, cp, out); break;
-    case 3: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 3, 6>>(B), nb, o, cp, out); break;
-    case 4: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 4, 6>>(B), nb, o, cp, out); break;
-    case 5: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 5, 6>>(B), nb, o, cp, out); break;
-    case 6: takeQR(Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 6, 6>>(B), nb, o, cp, out); break;
-    default: ws.qr.compute(B); takeQR(ws.qr, nb, o, cp, out);
-  }
+  qr.factor(nb, o.rank_abs_tol, o.rank_rel_tol);
+  const int rank = qr.rank;
+  cp.rank = rank;
+  cp.qr.resize(nb, 6);
+  for (int c = 0; c < rank; ++c)
+    for (int r = c + 1; r < nb; ++r) cp.qr(r, c) = qr.a[c][r];
+  for (int k = 0; k < rank; ++k) cp.hc[k] = qr.tau[k];
+  out.setZero(rank, 6);
+  for (int c = 0; c < 6; ++c)
+    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, qr.perm[c]) = qr.a[c][r];
 }
 
 /// Body rows of a constraint block, world covectors → body frame (adjoint of
@@ -147,7 +137,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       cur->nseg = 0;
       nb = nd.nK;
       if (nb > 0) {
-        ws.buf.topRows(nb) = nd.K;
+        stackRows(ws.qr, 0, nd.K);
         cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
       }
       dirty = false;
@@ -164,9 +154,9 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       if (r == 0) continue;
       if (nb + r > 12) flush();
       if (g.kind == Segment::Block)
-        ws.buf.middleRows(nb, r) = ws.blocks[g.id].Kbody;
+        stackRows(ws.qr, nb, ws.blocks[g.id].Kbody);
       else
-        ws.buf.middleRows(nb, r) = ws.nodes[g.id].KpassParent;
+        stackRows(ws.qr, nb, ws.nodes[g.id].KpassParent);
       cur->seg[cur->nseg++] = {g.kind, g.id, r};
       nb += r;
       dirty = true;

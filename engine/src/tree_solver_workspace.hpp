@@ -5,6 +5,8 @@
 
 #include <appell/tree_solver.hpp>
 
+#include "pivoted_qr.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <Eigen/SVD>
@@ -33,14 +35,14 @@ struct Segment {
 };
 
 /// One rank-revealing compression  Qᵀ E [stacked rows] = [K; ≈0].
-/// Q = H₀ H₁ ⋯ is kept as its Householder reflectors (as the QR left them:
+/// Q = H₀ H₁ ⋯ H_{rank−1} is kept as its Householder reflectors (pivoted_qr.hpp:
 /// essential parts below the diagonal of `qr`, scalars in `hc`); applying
-/// them costs O(nrows · 6) per vector where forming Q costs O(nrows² · 6).
+/// them costs O(nrows · rank) per vector where forming Q costs O(nrows² · 6).
 struct Compression {
   int nrows = 0;               ///< rows stacked
-  int rank = 0;                ///< rows kept
+  int rank = 0;                ///< rows kept = reflectors stored
   BufRows qr;                  ///< nrows × 6, reflectors below the diagonal
-  Eigen::Matrix<double, 6, 1> hc;  ///< reflector scalars τ (min(nrows, 6) used)
+  Eigen::Matrix<double, 6, 1> hc;  ///< reflector scalars τ (rank used)
   BufVec E;                    ///< row equilibration scales
   int nseg = 0;
   std::array<Segment, 13> seg;
@@ -83,14 +85,12 @@ inline void applyReflector(const Compression& cp, int k, BufVec& x) {
 
 /// x ← Qᵀ x (x has cp.nrows entries): H₀ first.
 inline void applyQt(const Compression& cp, BufVec& x) {
-  const int nh = std::min(cp.nrows, 6);
-  for (int k = 0; k < nh; ++k) applyReflector(cp, k, x);
+  for (int k = 0; k < cp.rank; ++k) applyReflector(cp, k, x);
 }
 
 /// x ← Q x (x has cp.nrows entries): the last reflector first.
 inline void applyQ(const Compression& cp, BufVec& x) {
-  const int nh = std::min(cp.nrows, 6);
-  for (int k = nh - 1; k >= 0; --k) applyReflector(cp, k, x);
+  for (int k = cp.rank - 1; k >= 0; --k) applyReflector(cp, k, x);
 }
 
 struct Node {
@@ -145,11 +145,9 @@ struct TreeWorkspace {
   std::vector<std::string> names;         ///< constraint names, for messages
 
   // Solver scratch with compile-time maximum sizes.
-  Eigen::ColPivHouseholderQR<BufRows> qr;
+  PivotedQR qr;
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
   Eigen::HouseholderQR<Mat6X> qrT;        ///< Kᵀ of a free joint (S = 1)
-  BufRows buf;
-  BufVec bufE;
 
   // Right sides of one pass.
   VecX tau;                               ///< generalized force of the pass
