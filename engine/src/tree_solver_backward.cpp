@@ -106,6 +106,144 @@ bool freeSplit(TreeWorkspace& ws, Node& nd) {
   return true;
 }
 
+/// One-DoF joint (revolute, prismatic, continuous: most bodies). The SVD of
+/// the column g = K s is its norm σ and a Householder reflector H = 1 − β u uᵀ
+/// with H g = ∓σ e₁, whose other columns span U₂ — kept as (u, β), never
+/// formed. With the row resolved (ρ = 1) nothing is free and
+///   H = Pᵀ IA P = IA − (gk zᵀ + z gkᵀ),  P = 1 − s gkᵀ, gk = Kᵀ g / σ²,
+///   z = IA s − ½ (sᵀ IA s) gk,
+/// a symmetric rank-2 update; otherwise it is ABA's 1-DoF elimination.
+void splitOneDof(const SolverOptions& o, const Joint& j, Node& nd, double& min_pivot) {
+  const int nK = nd.nK;
+  const Vec6 s = j.S.col(0);
+  double sigma = 0;
+  KVec g(nK);
+  if (nK > 0) {
+    g.noalias() = nd.K * s;
+    sigma = g.norm();
+  }
+  if (sigma > o.rank_abs_tol) {
+    min_pivot = std::min(min_pivot, sigma);
+    nd.rankG = 1;
+    nd.npass = nK - 1;
+    nd.nf = 0;
+    nd.Gpinv = g.transpose() / (sigma * sigma);
+    nd.V2.resize(1, 0);
+    nd.S2.resize(6, 0);
+    if (nK > 1) {
+      nd.u2form = U2Form::Reflector;
+      nd.hu = g / sigma;
+      nd.hu[0] += nd.hu[0] >= 0 ? 1.0 : -1.0;
+      nd.hbeta = 2.0 / nd.hu.squaredNorm();
+      // Kpass = U₂ᵀ K = rows 1… of H K = K − β u (uᵀ K).
+      const Eigen::Matrix<double, 1, 6> uK = nd.hu.transpose() * nd.K;
+      nd.Kpass = nd.K.bottomRows(nK - 1);
+      nd.Kpass.noalias() -= (nd.hbeta * nd.hu.tail(nK - 1)) * uK;
+    } else {
+      nd.u2form = U2Form::Identity;  // no rows left: U₂ is empty
+      nd.Kpass.resize(0, 6);
+    }
+    Vec6 gk;
+    gk.noalias() = nd.K.transpose() * nd.Gpinv.transpose();
+    nd.GK = gk.transpose();
+    nd.Ia = nd.IA;
+    const Vec6 w = nd.IA * s;
+    const Vec6 z = w - (0.5 * s.dot(w)) * gk;
+    nd.H = nd.IA;
+    nd.H.noalias() -= gk * z.transpose();
+    nd.H.noalias() -= z * gk.transpose();
+  } else {
+    nd.rankG = 0;
+    nd.npass = nK;
+    nd.nf = 1;
+    nd.u2form = U2Form::Identity;
+    nd.Kpass = nd.K;
+    nd.V2.setIdentity(1, 1);
+    nd.S2 = j.S;
+    const Vec6 U = nd.IA * s;
+    const double Dinv = 1.0 / s.dot(U);
+    nd.U = U;
+    nd.Dinv.setConstant(1, 1, Dinv);
+    nd.Ia = nd.IA;
+    nd.Ia.noalias() -= (Dinv * U) * U.transpose();
+    nd.H = nd.Ia;
+  }
+}
+
+/// Any other joint: a free joint's split from a QR of Kᵀ when well
+/// conditioned, otherwise the SVD of G = K S; then the free part eliminated
+/// as in ABA and H = Pᵀ Ia P.
+void splitGeneral(TreeWorkspace& ws, const Joint& j, Node& nd) {
+  const SolverOptions& o = ws.options;
+  const int nv = j.nv, nK = nd.nK;
+  int rho = 0;
+  nd.u2form = U2Form::Explicit;
+  if (nK > 0 && j.type == JointType::Floating && freeSplit(ws, nd)) {
+    rho = nK;
+  } else if (nK > 0 && nv > 0) {
+    const SmallMat G = nd.K * j.S;
+    ws.svd.compute(G, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const auto& sv = ws.svd.singularValues();
+    const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * sv(0));
+    while (rho < sv.size() && sv(rho) > thr) ++rho;
+    if (rho > 0) ws.min_pivot = std::min(ws.min_pivot, sv(rho - 1));
+    const auto& Um = ws.svd.matrixU();
+    const auto& Vm = ws.svd.matrixV();
+    if (rho > 0)
+      nd.Gpinv.noalias() = Vm.leftCols(rho) * sv.head(rho).cwiseInverse().asDiagonal() *
+                           Um.leftCols(rho).transpose();
+    nd.U2 = Um.rightCols(nK - rho);
+    nd.V2 = Vm.rightCols(nv - rho);
+  } else {
+    nd.u2form = U2Form::Identity;
+    nd.V2.setIdentity(nv, nv);
+  }
+  nd.rankG = rho;
+  nd.npass = nK - rho;
+  nd.nf = nv - rho;
+  if (nd.u2form == U2Form::Identity)
+    nd.Kpass = nd.K;
+  else if (nd.npass > 0)
+    nd.Kpass.noalias() = nd.U2.transpose() * nd.K;
+  else
+    nd.Kpass.resize(0, 6);
+
+  // GK = G⁺ K (nv × 6): P = 1 − S GK is a low-rank update of the identity,
+  // never formed when nv ≤ 2 (applied as x − GKᵀ(Sᵀx) / x − S(GK x)).
+  auto& GK = nd.GK;
+  if (rho > 0) {
+    GK.noalias() = nd.Gpinv * nd.K;
+    nd.S2.noalias() = j.S * nd.V2;
+  } else {
+    nd.S2 = j.S;
+  }
+  nd.Ia = nd.IA;
+  if (nd.nf > 0) {
+    nd.U.noalias() = nd.IA * nd.S2;
+    const SmallMat D = nd.S2.transpose() * nd.U;
+    nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
+    nd.Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
+  }
+  if (rho > 0 && nv <= 2) {
+    // Pᵀ Ia P = Ia P − GKᵀ (Sᵀ Ia P), Ia P = Ia − (Ia S) GK: O(36 nv) per
+    // factor instead of two dense 6 × 6 products.
+    Mat6X IaS(6, nv);
+    IaS.noalias() = nd.Ia * j.S;
+    Mat6 IaP = nd.Ia;
+    IaP.noalias() -= IaS * GK;
+    Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> SIaP(nv, 6);
+    SIaP.noalias() = j.S.transpose() * IaP;
+    nd.H = IaP;
+    nd.H.noalias() -= GK.transpose() * SIaP;
+  } else if (rho > 0) {
+    Mat6 P = Mat6::Identity();
+    P.noalias() -= j.S * GK;
+    nd.H.noalias() = P.transpose() * nd.Ia * P;
+  } else {
+    nd.H = nd.Ia;
+  }
+}
+
 }  // namespace
 
 void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
@@ -165,57 +303,14 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
 
     // 2. Split the joint: G = K S = U Σ Vᵀ; rows along U₁ fix V₁ᵀ q̈, rows
     //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.
-    const int nv = j.nv, nK = nd.nK;
-    int rho = 0;
-    if (nK > 0 && nv == 1) {
-      // One joint DoF: the SVD of the column g = K s is its norm and a
-      // Householder reflector H (H ĝ = ∓e₁) whose other columns span U₂.
-      KVec g(nK);
-      g.noalias() = nd.K * j.S.col(0);
-      const double sigma = g.norm();
-      if (sigma > o.rank_abs_tol) {
-        rho = 1;
-        ws.min_pivot = std::min(ws.min_pivot, sigma);
-        nd.Gpinv = g.transpose() / (sigma * sigma);
-        nd.V2.resize(1, 0);
-        if (nK > 1) {
-          KVec u = g / sigma;
-          u[0] += u[0] >= 0 ? 1.0 : -1.0;
-          SmallMat H = SmallMat::Identity(nK, nK);
-          H.noalias() -= (2.0 / u.squaredNorm()) * u * u.transpose();
-          nd.U2 = H.rightCols(nK - 1);
-        } else {
-          nd.U2.resize(1, 0);
-        }
-      } else {
-        nd.U2.setIdentity(nK, nK);
-        nd.V2.setIdentity(1, 1);
-      }
-    } else if (nK > 0 && j.type == JointType::Floating && freeSplit(ws, nd)) {
-      rho = nK;
-    } else if (nK > 0 && nv > 0) {
-      const SmallMat G = nd.K * j.S;
-      ws.svd.compute(G, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      const auto& s = ws.svd.singularValues();
-      const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * s(0));
-      while (rho < s.size() && s(rho) > thr) ++rho;
-      if (rho > 0) ws.min_pivot = std::min(ws.min_pivot, s(rho - 1));
-      const auto& Um = ws.svd.matrixU();
-      const auto& Vm = ws.svd.matrixV();
-      if (rho > 0)
-        nd.Gpinv.noalias() = Vm.leftCols(rho) * s.head(rho).cwiseInverse().asDiagonal() *
-                             Um.leftCols(rho).transpose();
-      nd.U2 = Um.rightCols(nK - rho);
-      nd.V2 = Vm.rightCols(nv - rho);
-    } else {
-      nd.U2.setIdentity(nK, nK);
-      nd.V2.setIdentity(nv, nv);
-    }
-    nd.rankG = rho;
-    nd.npass = nK - rho;
-    nd.nf = nv - rho;
+    // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
+    //    part z is eliminated as in ABA, and the parent sees H = Pᵀ Ia P — the
+    //    particular/free coupling the constrained-LQR equations drop.
+    if (j.nv == 1)
+      splitOneDof(o, j, nd, ws.min_pivot);
+    else
+      splitGeneral(ws, j, nd);
     if (nd.npass > 0) {
-      nd.Kpass.noalias() = nd.U2.transpose() * nd.K;
       if (p >= 0) {
         nd.KpassParent.resize(nd.npass, 6);
         for (int r = 0; r < nd.npass; ++r)
@@ -224,46 +319,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
         ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
       }
     } else {
-      nd.Kpass.resize(0, 6);
       nd.KpassParent.resize(0, 6);
-    }
-
-    // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
-    //    part z is eliminated as in ABA, and the parent sees Pᵀ Ia P — the
-    //    particular/free coupling the constrained-LQR equations drop.
-    // GK = G⁺ K (nv × 6): P = 1 − S GK is a low-rank update of the identity,
-    // never formed when nv ≤ 2 (applied as x − GKᵀ(Sᵀx) / x − S(GK x)).
-    auto& GK = nd.GK;
-    if (rho > 0) {
-      GK.noalias() = nd.Gpinv * nd.K;
-      nd.S2.noalias() = j.S * nd.V2;
-    } else {
-      nd.S2 = j.S;
-    }
-    nd.Ia = nd.IA;
-    if (nd.nf > 0) {
-      nd.U.noalias() = nd.IA * nd.S2;
-      const SmallMat D = nd.S2.transpose() * nd.U;
-      nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
-      nd.Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
-    }
-    if (rho > 0 && nv <= 2) {
-      // Pᵀ Ia P = Ia P − GKᵀ (Sᵀ Ia P), Ia P = Ia − (Ia S) GK: O(36 nv) per
-      // factor instead of two dense 6 × 6 products.
-      Mat6X IaS(6, nv);
-      IaS.noalias() = nd.Ia * j.S;
-      Mat6 IaP = nd.Ia;
-      IaP.noalias() -= IaS * GK;
-      Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> SIaP(nv, 6);
-      SIaP.noalias() = j.S.transpose() * IaP;
-      nd.H = IaP;
-      nd.H.noalias() -= GK.transpose() * SIaP;
-    } else if (rho > 0) {
-      Mat6 P = Mat6::Identity();
-      P.noalias() -= j.S * GK;
-      nd.H.noalias() = P.transpose() * nd.Ia * P;
-    } else {
-      nd.H = nd.Ia;
     }
     if (p >= 0) addCongruence(data.liMi[i], nd.H, ws.nodes[p].IA);
   }
@@ -344,7 +400,7 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
       ws.nodes[p].pA += data.liMi[i].actForce(g);
     }
     if (nd.npass > 0) {
-      nd.kpass.noalias() = nd.U2.transpose() * nd.k;
+      applyU2t(nd, nd.k, nd.kpass);
       if (ws.use_c) nd.kpass.noalias() -= nd.Kpass * nd.c;
     } else {
       nd.kpass.resize(0);

@@ -76,7 +76,7 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
         r -= tau;
         mu.noalias() += nd.Gpinv.transpose() * r;
       }
-      if (nd.npass > 0) mu.noalias() += nd.U2 * nd.nu;
+      if (nd.npass > 0) addU2(nd, nd.nu, mu);
       unrollNode(ws, i, nd.ncomp - 1, ws.lambda);
     }
   }

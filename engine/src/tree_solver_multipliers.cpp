@@ -114,13 +114,15 @@ std::string describeFailure(const Model& model, const Data& data, TreeWorkspace&
   } else {
     const Vec6 xa = data.liMi[i].actInv(ws.a_world);
     nd.nu = nd.kpass - nd.Kpass * xa;
-    nd.comp[nd.ncomp - 1].mu = nd.U2 * nd.nu;
+    nd.comp[nd.ncomp - 1].mu.setZero(nd.nK);
+    addU2(nd, nd.nu, nd.comp[nd.ncomp - 1].mu);
     unrollNode(ws, i, nd.ncomp - 1, cert);
   }
   for (int j = i + 1; j < model.nbodies; ++j) {
     Node& c = ws.nodes[j];
     if (!model.isAncestor(i, j) || c.ncomp == 0 || c.npass == 0) continue;
-    c.comp[c.ncomp - 1].mu = c.U2 * c.nu;
+    c.comp[c.ncomp - 1].mu.setZero(c.nK);
+    addU2(c, c.nu, c.comp[c.ncomp - 1].mu);
     unrollNode(ws, j, c.ncomp - 1, cert);
   }
 

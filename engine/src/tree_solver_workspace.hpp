@@ -93,6 +93,13 @@ inline void applyQ(const Compression& cp, BufVec& x) {
   for (int k = cp.rank - 1; k >= 0; --k) applyReflector(cp, k, x);
 }
 
+/// How U₂, the left null space of K S (rows handed to the parent), is held.
+enum class U2Form {
+  Identity,   ///< the joint resolves no row: U₂ = 1 (or nothing is left)
+  Reflector,  ///< one-DoF joint: columns 1… of H = 1 − β u uᵀ
+  Explicit,   ///< the SVD's columns, in U2
+};
+
 struct Node {
   std::vector<Segment> groups;            ///< own blocks, then children
   std::vector<Compression> comp;          ///< sized groups.size()
@@ -105,7 +112,10 @@ struct Node {
   int rankG = 0;                          ///< rows the joint resolves
   int npass = 0, nf = 0;                  ///< rows handed up; free joint directions
   SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK
-  SmallMat U2;                            ///< nK × npass, left null space of K S
+  U2Form u2form = U2Form::Identity;
+  SmallMat U2;                            ///< nK × npass (U2Form::Explicit)
+  KVec hu;                                ///< reflector vector (U2Form::Reflector)
+  double hbeta = 0;                       ///< reflector scalar β
   SmallMat V2;                            ///< nv × nf, right null space of K S
   KRows Kpass;                            ///< U2ᵀ K, this body's frame
   KRows KpassParent;                      ///< the same covectors in the parent's frame
@@ -128,6 +138,34 @@ struct Node {
   KVec mu;                                ///< multipliers of K
   KVec nu;                                ///< multipliers of the handed-up rows
 };
+
+/// y = U₂ᵀ x: right sides of the rows handed to the parent.
+inline void applyU2t(const Node& nd, const KVec& x, KVec& y) {
+  switch (nd.u2form) {
+    case U2Form::Identity: y = x.head(nd.npass); break;
+    case U2Form::Reflector: {
+      const double t = nd.hbeta * nd.hu.dot(x);
+      y = x.tail(nd.npass);
+      y.noalias() -= t * nd.hu.tail(nd.npass);
+      break;
+    }
+    case U2Form::Explicit: y.noalias() = nd.U2.transpose() * x; break;
+  }
+}
+
+/// y += U₂ ν: multipliers of the handed-up rows back on K.
+inline void addU2(const Node& nd, const KVec& nu, KVec& y) {
+  switch (nd.u2form) {
+    case U2Form::Identity: y.head(nd.npass) += nu; break;
+    case U2Form::Reflector: {
+      const double t = nd.hbeta * nd.hu.tail(nd.npass).dot(nu);
+      y.tail(nd.npass) += nu;
+      y.noalias() -= t * nd.hu;
+      break;
+    }
+    case U2Form::Explicit: y.noalias() += nd.U2 * nu; break;
+  }
+}
 
 struct Failure {
   bool failed = false;
