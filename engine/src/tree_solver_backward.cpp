@@ -48,6 +48,7 @@ void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
   for (int c = 0; c < rank; ++c)
     for (int r = c + 1; r < nb; ++r) cp.qr(r, c) = qr.a[c][r];
   for (int k = 0; k < rank; ++k) cp.hc[k] = qr.tau[k];
+  for (int c = 0; c < 6; ++c) cp.perm[c] = qr.perm[c];
   out.setZero(rank, 6);
   for (int c = 0; c < 6; ++c)
     for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, qr.perm[c]) = qr.a[c][r];
@@ -82,27 +83,48 @@ void addCongruence(const SE3& M, const Mat6& H, Mat6& out) {
   out.topLeftCorner<3, 3>().noalias() += A + ph * C - Bt * ph;
 }
 
-/// Split of a free joint (S = 1, so G = K) without an SVD. The compression
-/// left K (nK ≤ 6 rows) independent; Kᵀ = Q R (Householder) gives
-/// G⁺ = Q₁ R⁻ᵀ, V₂ = Q₂ and no rows to hand up. 1/‖R⁻¹‖_F ≤ σ_min(K) ≤
-/// √nK/‖R⁻¹‖_F, so when that lower bound is above the first refinement
-/// threshold (5·10⁻², far above the rank tolerances: ‖K‖ ≤ √12) the rank is
-/// full and the refinement decision is the SVD's; otherwise returns false
-/// and the caller takes the SVD.
+/// Split of a free joint (S = 1, so G = K) without an SVD. The last
+/// compression left K = [R₁₁ R₁₂] Πᵀ with R₁₁ upper triangular and
+/// nonsingular (its pivots passed the rank test), so
+///   G⁺ = Π [R₁₁⁻¹; 0]  (a right inverse: K G⁺ = 1),
+///   V₂ = Π [−R₁₁⁻¹ R₁₂; 1]  (a basis of null K),
+/// and no row is handed up. Neither need be orthogonal: the free part is
+/// minimised over all of null K, so v̇ is the constrained minimiser, and
+/// μ = G⁺ᵀ(Sᵀf − τ) is exact because the force balance along V₂ puts Sᵀf − τ
+/// in the range of Gᵀ. σ_min(K) ≥ σ_min(R₁₁) ≥ 1/‖R₁₁⁻¹‖_F: when that bound is
+/// above the first refinement threshold (5·10⁻², far above the rank
+/// tolerances: ‖K‖ ≤ √12) the split is well conditioned and the refinement
+/// decision is the SVD's; otherwise returns false and the caller takes the SVD.
 bool freeSplit(TreeWorkspace& ws, Node& nd) {
-  const int nK = nd.nK;
-  ws.qrT.compute(nd.K.transpose());
-  const Mat6 Q = ws.qrT.householderQ();
-  const auto R = ws.qrT.matrixQR().topRows(nK).template triangularView<Eigen::Upper>();
-  // Gpinvᵀ = R⁻¹ Q₁ᵀ.
-  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> Gt = Q.leftCols(nK).transpose();
-  R.solveInPlace(Gt);
-  const double lb = 1.0 / Gt.norm();  // ‖R⁻¹ Q₁ᵀ‖_F = ‖R⁻¹‖_F
+  const int n = nd.nK;
+  const auto& perm = nd.comp[nd.ncomp - 1].perm;
+  double R[6][6], Ri[6][6] = {};
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < 6; ++c) R[r][c] = nd.K(r, perm[c]);
+  double fro = 0;
+  for (int c = 0; c < n; ++c)  // back substitution, R₁₁ X = 1, column by column
+    for (int r = c; r >= 0; --r) {
+      double x = r == c ? 1.0 : 0.0;
+      for (int k = r + 1; k <= c; ++k) x -= R[r][k] * Ri[k][c];
+      Ri[r][c] = x / R[r][r];
+      fro += Ri[r][c] * Ri[r][c];
+    }
+  const double lb = 1.0 / std::sqrt(fro);
   if (!(lb > 5e-2)) return false;
   ws.min_pivot = std::min(ws.min_pivot, lb);
-  nd.Gpinv = Gt.transpose();
-  nd.U2.resize(nK, 0);
-  nd.V2 = Q.rightCols(6 - nK);
+  nd.Gpinv.setZero(6, n);
+  nd.V2.setZero(6, 6 - n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) nd.Gpinv(perm[r], c) = Ri[r][c];
+    for (int f = 0; f < 6 - n; ++f) {
+      double x = 0;
+      for (int k = r; k < n; ++k) x -= Ri[r][k] * R[k][n + f];
+      nd.V2(perm[r], f) = x;
+    }
+  }
+  for (int f = 0; f < 6 - n; ++f) nd.V2(perm[n + f], f) = 1;
+  nd.u2form = U2Form::Identity;
+  nd.npass = 0;
   return true;
 }
 
@@ -113,7 +135,7 @@ bool freeSplit(TreeWorkspace& ws, Node& nd) {
 ///   H = Pᵀ IA P = IA − (gk zᵀ + z gkᵀ),  P = 1 − s gkᵀ, gk = Kᵀ g / σ²,
 ///   z = IA s − ½ (sᵀ IA s) gk,
 /// a symmetric rank-2 update; otherwise it is ABA's 1-DoF elimination.
-void splitOneDof(const SolverOptions& o, const Joint& j, Node& nd, double& min_pivot) {
+void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, double& min_pivot) {
   const int nK = nd.nK;
   const Vec6 s = j.S.col(0);
   double sigma = 0;
@@ -143,6 +165,7 @@ void splitOneDof(const SolverOptions& o, const Joint& j, Node& nd, double& min_p
       nd.u2form = U2Form::Identity;  // no rows left: U₂ is empty
       nd.Kpass.resize(0, 6);
     }
+    if (root) return;  // H, GK and Ia only serve the parent
     Vec6 gk;
     gk.noalias() = nd.K.transpose() * nd.Gpinv.transpose();
     nd.GK = gk.transpose();
@@ -170,10 +193,10 @@ void splitOneDof(const SolverOptions& o, const Joint& j, Node& nd, double& min_p
   }
 }
 
-/// Any other joint: a free joint's split from a QR of Kᵀ when well
+/// Any other joint: a free joint's split from the compression's R₁₁ when well
 /// conditioned, otherwise the SVD of G = K S; then the free part eliminated
 /// as in ABA and H = Pᵀ Ia P.
-void splitGeneral(TreeWorkspace& ws, const Joint& j, Node& nd) {
+void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd) {
   const SolverOptions& o = ws.options;
   const int nv = j.nv, nK = nd.nK;
   int rho = 0;
@@ -212,7 +235,7 @@ void splitGeneral(TreeWorkspace& ws, const Joint& j, Node& nd) {
   // never formed when nv ≤ 2 (applied as x − GKᵀ(Sᵀx) / x − S(GK x)).
   auto& GK = nd.GK;
   if (rho > 0) {
-    GK.noalias() = nd.Gpinv * nd.K;
+    if (!root) GK.noalias() = nd.Gpinv * nd.K;
     nd.S2.noalias() = j.S * nd.V2;
   } else {
     nd.S2 = j.S;
@@ -222,8 +245,9 @@ void splitGeneral(TreeWorkspace& ws, const Joint& j, Node& nd) {
     nd.U.noalias() = nd.IA * nd.S2;
     const SmallMat D = nd.S2.transpose() * nd.U;
     nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
-    nd.Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
+    if (!root) nd.Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
   }
+  if (root) return;  // H, GK and Ia only serve the parent
   if (rho > 0 && nv <= 2) {
     // Pᵀ Ia P = Ia P − GKᵀ (Sᵀ Ia P), Ia P = Ia − (Ia S) GK: O(36 nv) per
     // factor instead of two dense 6 × 6 products.
@@ -307,9 +331,9 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     //    part z is eliminated as in ABA, and the parent sees H = Pᵀ Ia P — the
     //    particular/free coupling the constrained-LQR equations drop.
     if (j.nv == 1)
-      splitOneDof(o, j, nd, ws.min_pivot);
+      splitOneDof(o, j, p < 0, nd, ws.min_pivot);
     else
-      splitGeneral(ws, j, nd);
+      splitGeneral(ws, j, p < 0, nd);
     if (nd.npass > 0) {
       if (p >= 0) {
         nd.KpassParent.resize(nd.npass, 6);

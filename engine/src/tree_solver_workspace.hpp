@@ -44,6 +44,7 @@ struct Compression {
   BufRows qr;                  ///< nrows × 6, reflectors below the diagonal
   Eigen::Matrix<double, 6, 1> hc;  ///< reflector scalars τ (rank used)
   BufVec E;                    ///< row equilibration scales
+  std::array<int, 6> perm;     ///< column pivots: K = [R₁₁ R₁₂] Πᵀ, column c of R is perm[c]
   int nseg = 0;
   std::array<Segment, 13> seg;
   KVec rhs;                    ///< kept right sides (bias pass)
@@ -185,7 +186,6 @@ struct TreeWorkspace {
   // Solver scratch with compile-time maximum sizes.
   PivotedQR qr;
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
-  Eigen::HouseholderQR<Mat6X> qrT;        ///< Kᵀ of a free joint (S = 1)
 
   // Right sides of one pass.
   VecX tau;                               ///< generalized force of the pass
