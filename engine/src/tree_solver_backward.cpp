@@ -46,41 +46,43 @@ void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
   cp.rank = rank;
   cp.qr.resize(nb, 6);
   for (int c = 0; c < rank; ++c)
-    for (int r = c + 1; r < nb; ++r) cp.qr(r, c) = qr.a[c][r];
+    for (int r = c + 1; r < nb; ++r) cp.qr(r, c) = qr(r, c);
   for (int k = 0; k < rank; ++k) cp.hc[k] = qr.tau[k];
   for (int c = 0; c < 6; ++c) cp.perm[c] = qr.perm[c];
   out.setZero(rank, 6);
   for (int c = 0; c < 6; ++c)
-    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, qr.perm[c]) = qr.a[c][r];
+    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, qr.perm[c]) = qr(r, c);
 }
 
 /// Body rows of a constraint block, world covectors → body frame (adjoint of
-/// the motion transform: w_body = ᵒX_iᵀ w).
-void bodyRows(const Data& data, const ConstraintData& cdata, TreeBlock& tb) {
+/// the motion transform: w_body = ᵒX_iᵀ w), stacked at row `at` of the QR.
+void stackBodyRows(const Data& data, const ConstraintData& cdata, const TreeBlock& tb,
+                   PivotedQR& qr, int at) {
   const RowBlock& blk = cdata.blocks[tb.constraint];
   const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
   const SE3& oMi = data.oMi[tb.body];
-  tb.Kbody.resize(tb.rows, 6);
-  for (int r = 0; r < tb.rows; ++r)
-    tb.Kbody.row(r) = oMi.actInvForce(tb.sign * W.row(r).transpose()).transpose();
+  for (int r = 0; r < tb.rows; ++r) {
+    const Vec6 w = oMi.actInvForce(tb.sign * W.row(r).transpose());
+    for (int c = 0; c < 6; ++c) qr.a[c][at + r] = w[c];
+  }
 }
 
 /// out += Xᵀ H X with X = ᵖXᵢ (motion, parent → child) of M = liMi, i.e.
 /// out += F H Fᵀ with the force transform F = [R, p̂R; 0, R] — done blockwise
-/// (rotate the 3×3 blocks, then shear by p̂), about half the work of two dense
-/// 6×6 products and no 6×6 transform to build. H need not be symmetric.
+/// (rotate the 3×3 blocks, then shear by p̂), with no 6×6 transform built.
+/// H is symmetric (Pᵀ Ia P), so its lower-left block is never read and the
+/// result's lower-left block is the transpose of its upper-right one.
 void addCongruence(const SE3& M, const Mat6& H, Mat6& out) {
   const Mat3& R = M.R;
   const Mat3 A = R * H.topLeftCorner<3, 3>() * R.transpose();
   const Mat3 B = R * H.topRightCorner<3, 3>() * R.transpose();
-  const Mat3 C = R * H.bottomLeftCorner<3, 3>() * R.transpose();
   const Mat3 D = R * H.bottomRightCorner<3, 3>() * R.transpose();
   const Mat3 ph = skew(M.p);
   const Mat3 Bt = B + ph * D;  // top-right of T H' Tᵀ, T = [1, p̂; 0, 1]
   out.topRightCorner<3, 3>() += Bt;
-  out.bottomLeftCorner<3, 3>().noalias() += C - D * ph;
+  out.bottomLeftCorner<3, 3>() += Bt.transpose();
   out.bottomRightCorner<3, 3>() += D;
-  out.topLeftCorner<3, 3>().noalias() += A + ph * C - Bt * ph;
+  out.topLeftCorner<3, 3>().noalias() += A + ph * B.transpose() - Bt * ph;
 }
 
 /// Split of a free joint (S = 1, so G = K) without an SVD. The last
@@ -149,7 +151,7 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, do
     nd.rankG = 1;
     nd.npass = nK - 1;
     nd.nf = 0;
-    nd.Gpinv = g.transpose() / (sigma * sigma);
+    nd.Gpinv = (1.0 / (sigma * sigma)) * g.transpose();
     nd.V2.resize(1, 0);
     nd.S2.resize(6, 0);
     if (nK > 1) {
@@ -288,42 +290,34 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     nd.nK = 0;
     nd.K.resize(0, 6);
     int nb = 0;
-    bool dirty = false;
     Compression* cur = &nd.comp[0];
     cur->nseg = 0;
-    auto flush = [&]() {
+    auto compressStack = [&]() {
       compress(ws, *cur, nb, nd.K);
       nd.nK = cur->rank;
       ws.redundant += nb - cur->rank;
       cur = &nd.comp[++nd.ncomp];
       cur->nseg = 0;
-      nb = nd.nK;
-      if (nb > 0) {
-        stackRows(ws.qr, 0, nd.K);
-        cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
-      }
-      dirty = false;
     };
     for (const Segment& g : nd.groups) {
-      int r = 0;
-      if (g.kind == Segment::Block) {
-        TreeBlock& tb = ws.blocks[g.id];
-        bodyRows(data, cdata, tb);
-        r = tb.rows;
-      } else {
-        r = ws.nodes[g.id].npass;
-      }
+      const int r = g.kind == Segment::Block ? ws.blocks[g.id].rows : ws.nodes[g.id].npass;
       if (r == 0) continue;
-      if (nb + r > 12) flush();
+      if (nb + r > 12) {  // compress, and carry the kept rows on
+        compressStack();
+        nb = nd.nK;
+        if (nb > 0) {
+          stackRows(ws.qr, 0, nd.K);
+          cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
+        }
+      }
       if (g.kind == Segment::Block)
-        stackRows(ws.qr, nb, ws.blocks[g.id].Kbody);
+        stackBodyRows(data, cdata, ws.blocks[g.id], ws.qr, nb);
       else
         stackRows(ws.qr, nb, ws.nodes[g.id].KpassParent);
       cur->seg[cur->nseg++] = {g.kind, g.id, r};
       nb += r;
-      dirty = true;
     }
-    if (dirty) flush();
+    if (cur->nseg > 0) compressStack();
 
     // 2. Split the joint: G = K S = U Σ Vᵀ; rows along U₁ fix V₁ᵀ q̈, rows
     //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.

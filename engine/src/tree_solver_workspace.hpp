@@ -58,7 +58,6 @@ struct TreeBlock {
   double sign = 1;             ///< +1: rows Wₐ on bodyA; −1: rows −W_b on bodyB
   int rows = 0;
   int global = -1;             ///< first row in ConstraintData
-  KRows Kbody;                 ///< rows in the body frame (factor pass)
   KVec rhs;                    ///< right side on the gravity-shifted acceleration
 };
 
