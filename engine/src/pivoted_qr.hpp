@@ -30,42 +30,53 @@ struct PivotedQR {
   void factor(int nb, double abs_tol, double rel_tol) {
     // Columns are pivoted through `perm` rather than swapped in memory: a
     // swap right after the scalar writes that stacked the rows stalls on
-    // store forwarding, and costs more than the whole reflector update.
-    for (int c = 0; c < 6; ++c) perm[c] = c;
+    // store forwarding. The tail norms of the next step are summed inside
+    // the update that changes them (exact sums, no down-dating), and the
+    // reflector is applied unnormalised, H = 1 − γ u uᵀ with u = x − β e_k,
+    // γ = 1/(−β u_k): one division per step, overlapping the dot products.
+    double n2[6];
+    for (int c = 0; c < 6; ++c) {
+      perm[c] = c;
+      double s = 0;
+      for (int r = 0; r < nb; ++r) s += a[c][r] * a[c][r];
+      n2[c] = s;
+    }
     const int kmax = std::min(nb, 6);
-    double thr = abs_tol;
+    double thr2 = abs_tol * abs_tol;
     rank = 0;
     for (int k = 0; k < kmax; ++k) {
-      // Pivot: the remaining column of largest norm (recomputed, not
-      // down-dated: exact and cheap at ≤ 12 rows).
       int piv = k;
-      double best = -1;
-      for (int c = k; c < 6; ++c) {
-        const double* x = a[perm[c]];
-        double s = 0;
-        for (int r = k; r < nb; ++r) s += x[r] * x[r];
-        if (s > best) best = s, piv = c;
-      }
-      const double norm = std::sqrt(best);
-      if (k == 0) thr = std::max(abs_tol, rel_tol * norm);
-      if (!(norm > thr)) break;
+      for (int c = k + 1; c < 6; ++c)
+        if (n2[c] > n2[piv]) piv = c;
+      const double best = n2[piv];
+      if (k == 0) thr2 = std::max(thr2, rel_tol * rel_tol * best);
+      if (!(best > thr2)) break;  // |R_kk| = √best at most the tolerance
       std::swap(perm[k], perm[piv]);
-      // Reflector mapping column k to β e_k, β = −sign(a_kk) ‖·‖ (no cancellation).
+      std::swap(n2[k], n2[piv]);
       double* v = a[perm[k]];
       const double alpha = v[k];
-      const double beta = alpha >= 0 ? -norm : norm;
-      const double scale = 1.0 / (alpha - beta);
-      for (int r = k + 1; r < nb; ++r) v[r] *= scale;
-      tau[k] = (beta - alpha) / beta;
-      v[k] = beta;
+      const double norm = std::sqrt(best);
+      const double beta = alpha >= 0 ? -norm : norm;  // no cancellation in u_k
+      const double uk = alpha - beta;
+      const double gamma = 1.0 / (-beta * uk);
       for (int c = k + 1; c < 6; ++c) {
         double* x = a[perm[c]];
-        double t = x[k];
-        for (int r = k + 1; r < nb; ++r) t += v[r] * x[r];
-        t *= tau[k];
-        x[k] -= t;
-        for (int r = k + 1; r < nb; ++r) x[r] -= t * v[r];
+        double d = uk * x[k];
+        for (int r = k + 1; r < nb; ++r) d += v[r] * x[r];
+        const double t = gamma * d;
+        x[k] -= t * uk;
+        double s = 0;
+        for (int r = k + 1; r < nb; ++r) {
+          x[r] -= t * v[r];
+          s += x[r] * x[r];
+        }
+        n2[c] = s;
       }
+      // Eigen's normalisation: essential part u_r / u_k, τ = u_k² γ.
+      const double inv_uk = -beta * gamma;
+      for (int r = k + 1; r < nb; ++r) v[r] *= inv_uk;
+      tau[k] = uk * uk * gamma;
+      v[k] = beta;
       rank = k + 1;
     }
   }
