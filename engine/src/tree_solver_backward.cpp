@@ -137,7 +137,8 @@ bool freeSplit(TreeWorkspace& ws, Node& nd) {
 ///   H = Pᵀ IA P = IA − (gk zᵀ + z gkᵀ),  P = 1 − s gkᵀ, gk = Kᵀ g / σ²,
 ///   z = IA s − ½ (sᵀ IA s) gk,
 /// a symmetric rank-2 update; otherwise it is ABA's 1-DoF elimination.
-void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, double& min_pivot) {
+void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Mat6& H,
+                 double& min_pivot) {
   const int nK = nd.nK;
   const Vec6 s = j.S.col(0);
   double sigma = 0;
@@ -167,16 +168,16 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, do
       nd.u2form = U2Form::Identity;  // no rows left: U₂ is empty
       nd.Kpass.resize(0, 6);
     }
-    if (root) return;  // H, GK and Ia only serve the parent
+    if (root) return;  // H, GK and IaS only serve the parent
     Vec6 gk;
     gk.noalias() = nd.K.transpose() * nd.Gpinv.transpose();
     nd.GK = gk.transpose();
-    nd.Ia = nd.IA;
-    const Vec6 w = nd.IA * s;
+    const Vec6 w = nd.IA * s;  // nothing free: Ia = IA
+    nd.IaS = w;
     const Vec6 z = w - (0.5 * s.dot(w)) * gk;
-    nd.H = nd.IA;
-    nd.H.noalias() -= gk * z.transpose();
-    nd.H.noalias() -= z * gk.transpose();
+    H = nd.IA;
+    H.noalias() -= gk * z.transpose();
+    H.noalias() -= z * gk.transpose();
   } else {
     nd.rankG = 0;
     nd.npass = nK;
@@ -189,16 +190,15 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, do
     const double Dinv = 1.0 / s.dot(U);
     nd.U = U;
     nd.Dinv.setConstant(1, 1, Dinv);
-    nd.Ia = nd.IA;
-    nd.Ia.noalias() -= (Dinv * U) * U.transpose();
-    nd.H = nd.Ia;
+    H = nd.IA;
+    H.noalias() -= (Dinv * U) * U.transpose();
   }
 }
 
 /// Any other joint: a free joint's split from the compression's R₁₁ when well
 /// conditioned, otherwise the SVD of G = K S; then the free part eliminated
 /// as in ABA and H = Pᵀ Ia P.
-void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd) {
+void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H) {
   const SolverOptions& o = ws.options;
   const int nv = j.nv, nK = nd.nK;
   int rho = 0;
@@ -242,31 +242,26 @@ void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd) {
   } else {
     nd.S2 = j.S;
   }
-  nd.Ia = nd.IA;
   if (nd.nf > 0) {
     nd.U.noalias() = nd.IA * nd.S2;
     const SmallMat D = nd.S2.transpose() * nd.U;
     nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
-    if (!root) nd.Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
   }
-  if (root) return;  // H, GK and Ia only serve the parent
-  if (rho > 0 && nv <= 2) {
+  if (root) return;  // H, GK and IaS only serve the parent
+  Mat6 Ia = nd.IA;
+  if (nd.nf > 0) Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
+  if (rho > 0) {
     // Pᵀ Ia P = Ia P − GKᵀ (Sᵀ Ia P), Ia P = Ia − (Ia S) GK: O(36 nv) per
     // factor instead of two dense 6 × 6 products.
-    Mat6X IaS(6, nv);
-    IaS.noalias() = nd.Ia * j.S;
-    Mat6 IaP = nd.Ia;
-    IaP.noalias() -= IaS * GK;
+    nd.IaS.noalias() = Ia * j.S;
+    Mat6 IaP = Ia;
+    IaP.noalias() -= nd.IaS * GK;
     Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> SIaP(nv, 6);
     SIaP.noalias() = j.S.transpose() * IaP;
-    nd.H = IaP;
-    nd.H.noalias() -= GK.transpose() * SIaP;
-  } else if (rho > 0) {
-    Mat6 P = Mat6::Identity();
-    P.noalias() -= j.S * GK;
-    nd.H.noalias() = P.transpose() * nd.Ia * P;
+    H = IaP;
+    H.noalias() -= GK.transpose() * SIaP;
   } else {
-    nd.H = nd.Ia;
+    H = Ia;
   }
 }
 
@@ -324,10 +319,11 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
     //    part z is eliminated as in ABA, and the parent sees H = Pᵀ Ia P — the
     //    particular/free coupling the constrained-LQR equations drop.
+    Mat6 H;
     if (j.nv == 1)
-      splitOneDof(o, j, p < 0, nd, ws.min_pivot);
+      splitOneDof(o, j, p < 0, nd, H, ws.min_pivot);
     else
-      splitGeneral(ws, j, p < 0, nd);
+      splitGeneral(ws, j, p < 0, nd, H);
     if (nd.npass > 0) {
       if (p >= 0) {
         nd.KpassParent.resize(nd.npass, 6);
@@ -339,7 +335,10 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     } else {
       nd.KpassParent.resize(0, 6);
     }
-    if (p >= 0) addCongruence(data.liMi[i], nd.H, ws.nodes[p].IA);
+    if (p >= 0) {
+      nd.Hc.noalias() = H * nd.c;  // the velocity-product term of the bias pass
+      addCongruence(data.liMi[i], H, ws.nodes[p].IA);
+    }
   }
 }
 
@@ -388,8 +387,6 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
       nd.k.resize(0);
 
     const auto tau = ws.tau.segment(j.idx_v, j.nv);
-    Vec6 d = Vec6::Zero();
-    if (nd.rankG > 0) d.noalias() = j.S * (nd.Gpinv * nd.k);
     if (nd.nf > 0) {
       if (nd.rankG > 0)
         nd.u.noalias() = nd.V2.transpose() * tau;
@@ -401,20 +398,19 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
       Vec6 pa = nd.pA;
       if (nd.nf > 0) pa.noalias() += nd.U * (nd.Dinv * nd.u);
       // Gradient of the child's cost-to-go in ā = X a_p + c:
-      //   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ.
-      Vec6 g = ws.use_c ? Vec6(nd.H * nd.c) : Vec6::Zero();
+      //   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ,   d = S G⁺ k,
+      // with Pᵀ x = x − GKᵀ(Sᵀ x) and Kᵀ G⁺ᵀ = GKᵀ:  H ā + x − GKᵀ(Sᵀx − τ).
+      Vec6 g = ws.use_c ? nd.Hc : Vec6::Zero();
       if (nd.rankG > 0) {
-        // Pᵀ x = x − GKᵀ (Sᵀ x)
-        Vec6 x = pa;
-        x.noalias() += nd.Ia * d;
+        KVec y(j.nv);
+        y.noalias() = nd.Gpinv * nd.k;
+        pa.noalias() += nd.IaS * y;
         KVec sx(j.nv);
-        sx.noalias() = j.S.transpose() * x;
-        g += x;
+        sx.noalias() = j.S.transpose() * pa;
+        sx -= tau;
         g.noalias() -= nd.GK.transpose() * sx;
-        g.noalias() += nd.K.transpose() * (nd.Gpinv.transpose() * tau);
-      } else {
-        g += pa;
       }
+      g += pa;
       ws.nodes[p].pA += data.liMi[i].actForce(g);
     }
     if (nd.npass > 0) {

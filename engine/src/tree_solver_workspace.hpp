@@ -122,8 +122,8 @@ struct Node {
   Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK
   Mat6X S2, U;                            ///< S V2 and IA S V2
   SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
-  Mat6 Ia;                                ///< IA − U D⁻¹ Uᵀ
-  Mat6 H;                                 ///< Pᵀ Ia P: what the parent sees
+  Mat6X IaS;                              ///< Ia S, Ia = IA − U D⁻¹ Uᵀ (ρ > 0, not the root)
+  Vec6 Hc;                                ///< H c, H = Pᵀ Ia P what the parent sees
 
   // Bias pass (depends on the right sides).
   Vec6 bias0;                             ///< initial bias force (v ×* I v, or unit forces)
