@@ -355,18 +355,8 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
     // Right sides through the recorded compressions: Qᵀ E r.
     for (int e = 0; e < nd.ncomp; ++e) {
       Compression& cp = nd.comp[e];
-      BufVec r(cp.nrows);
-      int off = 0;
-      for (int s = 0; s < cp.nseg; ++s) {
-        const Segment& g = cp.seg[s];
-        if (g.kind == Segment::Previous)
-          r.segment(off, g.rows) = nd.comp[e - 1].rhs;
-        else if (g.kind == Segment::Block)
-          r.segment(off, g.rows) = ws.blocks[g.id].rhs;
-        else
-          r.segment(off, g.rows) = ws.nodes[g.id].kpass;
-        off += g.rows;
-      }
+      BufVec r;
+      gatherRhs(ws, i, e, r);
       r.array() *= cp.E.array();
       BufVec t = r;
       applyQt(cp, t);

@@ -70,9 +70,12 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
       KVec& mu = nd.comp[nd.ncomp - 1].mu;
       mu.setZero(nd.nK);
       if (nd.rankG > 0) {
-        const Vec6 f = nd.IA * a + nd.pA;
         KVec r(j.nv);
-        r.noalias() = j.S.transpose() * f;
+        if (nd.nf == 0 && p >= 0)  // Ia = IA, so Sᵀ IA a = (Ia S)ᵀ a, kept by the factor pass
+          r.noalias() = nd.IaS.transpose() * a;
+        else
+          r.noalias() = j.S.transpose() * (nd.IA * a);
+        r.noalias() += j.S.transpose() * nd.pA;
         r -= tau;
         mu.noalias() += nd.Gpinv.transpose() * r;
       }

@@ -91,18 +91,8 @@ std::string describeFailure(const Model& model, const Data& data, TreeWorkspace&
   // as a multiplier would be.
   if (f.comp >= 0) {
     const Compression& cp = nd.comp[f.comp];
-    BufVec r(cp.nrows);
-    int off = 0;
-    for (int s = 0; s < cp.nseg; ++s) {
-      const Segment& g = cp.seg[s];
-      if (g.kind == Segment::Previous)
-        r.segment(off, g.rows) = nd.comp[f.comp - 1].rhs;
-      else if (g.kind == Segment::Block)
-        r.segment(off, g.rows) = ws.blocks[g.id].rhs;
-      else
-        r.segment(off, g.rows) = ws.nodes[g.id].kpass;
-      off += g.rows;
-    }
+    BufVec r;
+    gatherRhs(ws, i, f.comp, r);
     r.array() *= cp.E.array();
     BufVec lam = r;
     applyQt(cp, lam);

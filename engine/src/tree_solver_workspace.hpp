@@ -213,6 +213,23 @@ struct TreeWorkspace {
   std::string last_error;
 };
 
+/// Right sides of the rows stacked in compression e of body i, before
+/// equilibration: the previous compression's kept rows, constraint blocks and
+/// children's handed-up rows, in stacking order.
+inline void gatherRhs(const TreeWorkspace& ws, int i, int e, BufVec& r) {
+  const Node& nd = ws.nodes[i];
+  const Compression& cp = nd.comp[e];
+  r.resize(cp.nrows);
+  double* out = r.data();
+  for (int s = 0; s < cp.nseg; ++s) {
+    const Segment& g = cp.seg[s];
+    const double* in = g.kind == Segment::Previous ? nd.comp[e - 1].rhs.data()
+                       : g.kind == Segment::Block  ? ws.blocks[g.id].rhs.data()
+                                                   : ws.nodes[g.id].kpass.data();
+    for (int k = 0; k < g.rows; ++k) *out++ = in[k];
+  }
+}
+
 // Passes (tree_solver_backward.cpp, tree_solver_forward.cpp, tree_solver_loops.cpp).
 void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
                 TreeWorkspace& ws);
