@@ -22,15 +22,14 @@ void stackRows(PivotedQR& qr, int at, const Rows& rows) {
     for (int r = 0; r < rows.rows(); ++r) qr.a[c][at + r] = rows(r, c);
 }
 
-/// Rank-revealing compression of the first `nb` rows stacked in ws.qr:
+/// Rank-revealing compression of the `nb` rows stacked in cp.f:
 /// equilibrate each row (rows already below the absolute tolerance are left
 /// alone, so round-off residue of a redundant row is never blown up into a
 /// fake constraint), then Householder QR with column pivoting, Qᵀ E B Π = R,
-/// stopped at the numerical rank (pivoted_qr.hpp). Keeps the reflectors and
-/// sets out = Q₁ᵀ E B = R₁ Πᵀ — read off R, no product with Q.
-void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
-  const SolverOptions& o = ws.options;
-  PivotedQR& qr = ws.qr;
+/// stopped at the numerical rank (pivoted_qr.hpp). Sets out = Q₁ᵀ E B = R₁ Πᵀ
+/// — read off R, no product with Q.
+void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out) {
+  PivotedQR& qr = cp.f;
   cp.nrows = nb;
   cp.E.resize(nb);
   for (int r = 0; r < nb; ++r) {
@@ -44,11 +43,6 @@ void compress(TreeWorkspace& ws, Compression& cp, int nb, KRows& out) {
   qr.factor(nb, o.rank_abs_tol, o.rank_rel_tol);
   const int rank = qr.rank;
   cp.rank = rank;
-  cp.qr.resize(nb, 6);
-  for (int c = 0; c < rank; ++c)
-    for (int r = c + 1; r < nb; ++r) cp.qr(r, c) = qr(r, c);
-  for (int k = 0; k < rank; ++k) cp.hc[k] = qr.tau[k];
-  for (int c = 0; c < 6; ++c) cp.perm[c] = qr.perm[c];
   out.setZero(rank, 6);
   for (int c = 0; c < 6; ++c)
     for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, qr.perm[c]) = qr(r, c);
@@ -99,7 +93,7 @@ void addCongruence(const SE3& M, const Mat6& H, Mat6& out) {
 /// decision is the SVD's; otherwise returns false and the caller takes the SVD.
 bool freeSplit(TreeWorkspace& ws, Node& nd) {
   const int n = nd.nK;
-  const auto& perm = nd.comp[nd.ncomp - 1].perm;
+  const int* perm = nd.comp[nd.ncomp - 1].f.perm;
   double R[6][6], Ri[6][6] = {};
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < 6; ++c) R[r][c] = nd.K(r, perm[c]);
@@ -288,7 +282,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     Compression* cur = &nd.comp[0];
     cur->nseg = 0;
     auto compressStack = [&]() {
-      compress(ws, *cur, nb, nd.K);
+      compress(o, *cur, nb, nd.K);
       nd.nK = cur->rank;
       ws.redundant += nb - cur->rank;
       cur = &nd.comp[++nd.ncomp];
@@ -301,14 +295,14 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
         compressStack();
         nb = nd.nK;
         if (nb > 0) {
-          stackRows(ws.qr, 0, nd.K);
+          stackRows(cur->f, 0, nd.K);
           cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
         }
       }
       if (g.kind == Segment::Block)
-        stackBodyRows(data, cdata, ws.blocks[g.id], ws.qr, nb);
+        stackBodyRows(data, cdata, ws.blocks[g.id], cur->f, nb);
       else
-        stackRows(ws.qr, nb, ws.nodes[g.id].KpassParent);
+        stackRows(cur->f, nb, ws.nodes[g.id].KpassParent);
       cur->seg[cur->nseg++] = {g.kind, g.id, r};
       nb += r;
     }

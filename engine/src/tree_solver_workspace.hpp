@@ -34,17 +34,16 @@ struct Segment {
   int rows = 0;
 };
 
-/// One rank-revealing compression  Qᵀ E [stacked rows] = [K; ≈0].
-/// Q = H₀ H₁ ⋯ H_{rank−1} is kept as its Householder reflectors (pivoted_qr.hpp:
-/// essential parts below the diagonal of `qr`, scalars in `hc`); applying
-/// them costs O(nrows · rank) per vector where forming Q costs O(nrows² · 6).
+/// One rank-revealing compression  Qᵀ E [stacked rows] Π = [R₁; ≈0], K = R₁ Πᵀ.
+/// The rows are stacked straight into the factorization's storage and
+/// Q = H₀ H₁ ⋯ H_{rank−1} stays there as its Householder reflectors
+/// (pivoted_qr.hpp); applying them costs O(nrows · rank) per vector where
+/// forming Q costs O(nrows² · 6).
 struct Compression {
   int nrows = 0;               ///< rows stacked
   int rank = 0;                ///< rows kept = reflectors stored
-  BufRows qr;                  ///< nrows × 6, reflectors below the diagonal
-  Eigen::Matrix<double, 6, 1> hc;  ///< reflector scalars τ (rank used)
+  PivotedQR f;                 ///< R, reflectors, scalars τ and column pivots Π
   BufVec E;                    ///< row equilibration scales
-  std::array<int, 6> perm;     ///< column pivots: K = [R₁₁ R₁₂] Πᵀ, column c of R is perm[c]
   int nseg = 0;
   std::array<Segment, 13> seg;
   KVec rhs;                    ///< kept right sides (bias pass)
@@ -74,13 +73,13 @@ struct LoopRow {
 /// the compression's QR, Eigen's storage). Written out: Eigen's generic
 /// applyHouseholderOnTheLeft costs several times more on these short vectors.
 inline void applyReflector(const Compression& cp, int k, BufVec& x) {
-  const double tau = cp.hc[k];
-  if (tau == 0) return;
+  const double tau = cp.f.tau[k];
+  const double* v = cp.f.a[cp.f.perm[k]];
   double t = x[k];
-  for (int r = k + 1; r < cp.nrows; ++r) t += cp.qr(r, k) * x[r];
+  for (int r = k + 1; r < cp.nrows; ++r) t += v[r] * x[r];
   t *= tau;
   x[k] -= t;
-  for (int r = k + 1; r < cp.nrows; ++r) x[r] -= t * cp.qr(r, k);
+  for (int r = k + 1; r < cp.nrows; ++r) x[r] -= t * v[r];
 }
 
 /// x ← Qᵀ x (x has cp.nrows entries): H₀ first.
@@ -183,7 +182,6 @@ struct TreeWorkspace {
   std::vector<std::string> names;         ///< constraint names, for messages
 
   // Solver scratch with compile-time maximum sizes.
-  PivotedQR qr;
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
 
   // Right sides of one pass.
