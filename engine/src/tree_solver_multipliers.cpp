@@ -20,16 +20,23 @@ namespace {
 /// Hands the stacked-row multipliers `lam` of compression `e` to their owners.
 void distribute(TreeWorkspace& ws, Node& nd, int e, const BufVec& lam, VecX& lambda) {
   const Compression& cp = nd.comp[e];
-  int off = 0;
+  const double* in = lam.data();
   for (int s = 0; s < cp.nseg; ++s) {
     const Segment& g = cp.seg[s];
-    if (g.kind == Segment::Previous)
-      nd.comp[e - 1].mu = lam.segment(off, g.rows);
-    else if (g.kind == Segment::Block)
-      lambda.segment(ws.blocks[g.id].global, g.rows) = lam.segment(off, g.rows);
-    else
-      ws.nodes[g.id].nu = lam.segment(off, g.rows);
-    off += g.rows;
+    double* out;
+    if (g.kind == Segment::Previous) {
+      KVec& mu = nd.comp[e - 1].mu;
+      mu.resize(g.rows);
+      out = mu.data();
+    } else if (g.kind == Segment::Block) {
+      out = lambda.data() + ws.blocks[g.id].global;
+    } else {
+      KVec& nu = ws.nodes[g.id].nu;
+      nu.resize(g.rows);
+      out = nu.data();
+    }
+    for (int k = 0; k < g.rows; ++k) out[k] = in[k];
+    in += g.rows;
   }
 }
 
@@ -39,10 +46,10 @@ void unrollNode(TreeWorkspace& ws, int body, int from, VecX& lambda) {
   Node& nd = ws.nodes[body];
   for (int e = from; e >= 0; --e) {
     const Compression& cp = nd.comp[e];
-    BufVec lam = BufVec::Zero(cp.nrows);
-    lam.head(cp.rank) = cp.mu;
+    BufVec lam(cp.nrows);
+    for (int k = 0; k < cp.nrows; ++k) lam[k] = k < cp.rank ? cp.mu[k] : 0.0;
     applyQ(cp, lam);
-    lam.array() *= cp.E.array();
+    for (int k = 0; k < cp.nrows; ++k) lam[k] *= cp.E[k];
     distribute(ws, nd, e, lam, lambda);
   }
 }
