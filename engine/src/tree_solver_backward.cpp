@@ -146,9 +146,7 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Ma
     nd.rankG = 1;
     nd.npass = nK - 1;
     nd.nf = 0;
-    nd.Gpinv = (1.0 / (sigma * sigma)) * g.transpose();
-    nd.V2.resize(1, 0);
-    nd.S2.resize(6, 0);
+    nd.Gpinv = (1.0 / (sigma * sigma)) * g.transpose();  // nothing free: V2, S2 unused
     if (nK > 1) {
       nd.u2form = U2Form::Reflector;
       nd.hu = g / sigma;

@@ -100,42 +100,43 @@ enum class U2Form {
 };
 
 struct Node {
-  std::vector<Segment> groups;            ///< own blocks, then children
-  std::vector<Compression> comp;          ///< sized groups.size()
+  // Ordered by use, not by pass: what every body touches in every solve
+  // first and together (fewer cache lines per body), what only multi-DoF or
+  // unresolved joints use last.
   int ncomp = 0;
-
-  // Factor pass (depends on q and the rows only).
-  Mat6 IA;                                ///< articulated inertia before the joint
   int nK = 0;                             ///< compressed rows at this body
-  KRows K;                                ///< compressed rows, body frame
   int rankG = 0;                          ///< rows the joint resolves
   int npass = 0, nf = 0;                  ///< rows handed up; free joint directions
-  SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK
   U2Form u2form = U2Form::Identity;
-  SmallMat U2;                            ///< nK × npass (U2Form::Explicit)
-  KVec hu;                                ///< reflector vector (U2Form::Reflector)
-  double hbeta = 0;                       ///< reflector scalar β
-  SmallMat V2;                            ///< nv × nf, right null space of K S
-  KRows Kpass;                            ///< U2ᵀ K, this body's frame
-  KRows KpassParent;                      ///< the same covectors in the parent's frame
-  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK
-  Mat6X S2, U;                            ///< S V2 and IA S V2
-  SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
-  Mat6X IaS;                              ///< Ia S, Ia = IA − U D⁻¹ Uᵀ (ρ > 0, not the root)
+  double hbeta = 0;                       ///< reflector scalar β (U2Form::Reflector)
   Vec6 Hc;                                ///< H c, H = Pᵀ Ia P what the parent sees
-
-  // Bias pass (depends on the right sides).
   Vec6 bias0;                             ///< initial bias force (v ×* I v, or unit forces)
   Vec6 pA;                                ///< articulated bias before the joint
   Vec6 c;                                 ///< velocity-product acceleration v × S q̇
+  Vec6 a;                                 ///< acceleration (gravity-shifted)
+  KVec hu;                                ///< reflector vector (U2Form::Reflector)
   KVec k;                                 ///< right sides of K
   KVec kpass;                             ///< right sides of the handed-up rows (on a_parent)
+  KVec nu;                                ///< multipliers of the handed-up rows
+
+  // Factors (depend on q and the rows only).
+  KRows K;                                ///< compressed rows, body frame
+  KRows Kpass;                            ///< U2ᵀ K, this body's frame
+  KRows KpassParent;                      ///< the same covectors in the parent's frame
+  SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK
+  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK
+  Mat6X IaS;                              ///< Ia S, Ia = IA − U D⁻¹ Uᵀ (ρ > 0, not the root)
+  Mat6 IA;                                ///< articulated inertia before the joint
+
+  // Free directions and general splits.
+  SmallMat U2;                            ///< nK × npass (U2Form::Explicit)
+  SmallMat V2;                            ///< nv × nf, right null space of K S
+  Mat6X S2, U;                            ///< S V2 and IA S V2
+  SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
   KVec u;                                 ///< V2ᵀ τ − S2ᵀ pA
 
-  // Forward pass.
-  Vec6 a;                                 ///< acceleration (gravity-shifted)
-  KVec mu;                                ///< multipliers of K
-  KVec nu;                                ///< multipliers of the handed-up rows
+  std::vector<Segment> groups;            ///< own blocks, then children
+  std::vector<Compression> comp;          ///< sized groups.size() + 1
 };
 
 /// y = U₂ᵀ x: right sides of the rows handed to the parent.
