@@ -19,7 +19,7 @@ namespace {
 template <class Rows>
 void stackRows(PivotedQR& qr, int at, const Rows& rows) {
   for (int c = 0; c < 6; ++c)
-    for (int r = 0; r < rows.rows(); ++r) qr.a[c][at + r] = rows(r, c);
+    for (int r = 0; r < rows.rows(); ++r) qr.a[at + r][c] = rows(r, c);
 }
 
 /// Rank-revealing compression of the `nb` rows stacked in cp.f:
@@ -34,11 +34,11 @@ void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out) {
   cp.E.resize(nb);
   for (int r = 0; r < nb; ++r) {
     double n2 = 0;
-    for (int c = 0; c < 6; ++c) n2 += qr.a[c][r] * qr.a[c][r];
+    for (int c = 0; c < 6; ++c) n2 += qr.a[r][c] * qr.a[r][c];
     const double n = std::sqrt(n2);
     const double e = n > o.rank_abs_tol ? 1.0 / n : 1.0;
     cp.E[r] = e;
-    for (int c = 0; c < 6; ++c) qr.a[c][r] *= e;
+    for (int c = 0; c < 6; ++c) qr.a[r][c] *= e;
   }
   qr.factor(nb, o.rank_abs_tol, o.rank_rel_tol);
   const int rank = qr.rank;
@@ -57,7 +57,7 @@ void stackBodyRows(const Data& data, const ConstraintData& cdata, const TreeBloc
   const SE3& oMi = data.oMi[tb.body];
   for (int r = 0; r < tb.rows; ++r) {
     const Vec6 w = oMi.actInvForce(tb.sign * W.row(r).transpose());
-    for (int c = 0; c < 6; ++c) qr.a[c][at + r] = w[c];
+    for (int c = 0; c < 6; ++c) qr.a[at + r][c] = w[c];
   }
 }
 

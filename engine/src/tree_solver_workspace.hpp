@@ -74,12 +74,12 @@ struct LoopRow {
 /// applyHouseholderOnTheLeft costs several times more on these short vectors.
 inline void applyReflector(const Compression& cp, int k, BufVec& x) {
   const double tau = cp.f.tau[k];
-  const double* v = cp.f.a[cp.f.perm[k]];
+  const int pk = cp.f.perm[k];
   double t = x[k];
-  for (int r = k + 1; r < cp.nrows; ++r) t += v[r] * x[r];
+  for (int r = k + 1; r < cp.nrows; ++r) t += cp.f.a[r][pk] * x[r];
   t *= tau;
   x[k] -= t;
-  for (int r = k + 1; r < cp.nrows; ++r) x[r] -= t * v[r];
+  for (int r = k + 1; r < cp.nrows; ++r) x[r] -= t * cp.f.a[r][pk];
 }
 
 /// x ← Qᵀ x (x has cp.nrows entries): H₀ first.
