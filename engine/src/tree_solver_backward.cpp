@@ -48,6 +48,15 @@ void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out) {
     for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, qr.perm[c]) = qr(r, c);
 }
 
+/// A child's handed-up rows (its frame) mapped to this body's frame by the
+/// force transform and stacked at row `at` of the QR.
+void stackChildRows(const SE3& liMi, const KRows& rows, PivotedQR& qr, int at) {
+  for (int r = 0; r < rows.rows(); ++r) {
+    const Vec6 w = liMi.actForce(rows.row(r).transpose());
+    for (int c = 0; c < 6; ++c) qr.a[at + r][c] = w[c];
+  }
+}
+
 /// Body rows of a constraint block, world covectors → body frame (adjoint of
 /// the motion transform: w_body = ᵒX_iᵀ w), stacked at row `at` of the QR.
 void stackBodyRows(const Data& data, const ConstraintData& cdata, const TreeBlock& tb,
@@ -300,7 +309,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       if (g.kind == Segment::Block)
         stackBodyRows(data, cdata, ws.blocks[g.id], cur->f, nb);
       else
-        stackRows(cur->f, nb, ws.nodes[g.id].KpassParent);
+        stackChildRows(data.liMi[g.id], ws.nodes[g.id].Kpass, cur->f, nb);
       cur->seg[cur->nseg++] = {g.kind, g.id, r};
       nb += r;
     }
@@ -316,17 +325,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       splitOneDof(o, j, p < 0, nd, H, ws.min_pivot);
     else
       splitGeneral(ws, j, p < 0, nd, H);
-    if (nd.npass > 0) {
-      if (p >= 0) {
-        nd.KpassParent.resize(nd.npass, 6);
-        for (int r = 0; r < nd.npass; ++r)
-          nd.KpassParent.row(r) = data.liMi[i].actForce(nd.Kpass.row(r).transpose()).transpose();
-      } else {
-        ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
-      }
-    } else {
-      nd.KpassParent.resize(0, 6);
-    }
+    if (p < 0) ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
     if (p >= 0) {
       nd.Hc.noalias() = H * nd.c;  // the velocity-product term of the bias pass
       addCongruence(data.liMi[i], H, ws.nodes[p].IA);

@@ -122,7 +122,6 @@ struct Node {
   // Factors (depend on q and the rows only).
   KRows K;                                ///< compressed rows, body frame
   KRows Kpass;                            ///< U2ᵀ K, this body's frame
-  KRows KpassParent;                      ///< the same covectors in the parent's frame
   SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK
   Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK
   Mat6X IaS;                              ///< Ia S, Ia = IA − U D⁻¹ Uᵀ (ρ > 0, not the root)
