@@ -155,7 +155,7 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Ma
     nd.rankG = 1;
     nd.npass = nK - 1;
     nd.nf = 0;
-    nd.Gpinv = (1.0 / (sigma * sigma)) * g.transpose();  // nothing free: V2, S2 unused
+    nd.gp = (1.0 / (sigma * sigma)) * g;  // G⁺ᵀ; nothing free: V2, S2 unused
     if (nK > 1) {
       nd.u2form = U2Form::Reflector;
       nd.hu = g / sigma;
@@ -169,12 +169,10 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Ma
       nd.u2form = U2Form::Identity;  // no rows left: U₂ is empty
       nd.Kpass.resize(0, 6);
     }
-    if (root) return;  // H, GK and IaS only serve the parent
-    Vec6 gk;
-    gk.noalias() = nd.K.transpose() * nd.Gpinv.transpose();
-    nd.GK = gk.transpose();
-    const Vec6 w = nd.IA * s;  // nothing free: Ia = IA
-    nd.IaS = w;
+    if (root) return;  // H, gk and ias only serve the parent
+    Vec6& gk = nd.gk;
+    gk.noalias() = nd.K.transpose() * nd.gp;
+    const Vec6& w = nd.ias = nd.IA * s;  // nothing free: Ia = IA
     const Vec6 z = w - (0.5 * s.dot(w)) * gk;
     H = nd.IA;
     H.noalias() -= gk * z.transpose();
@@ -382,7 +380,10 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
       //   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ,   d = S G⁺ k,
       // with Pᵀ x = x − GKᵀ(Sᵀ x) and Kᵀ G⁺ᵀ = GKᵀ:  H ā + x − GKᵀ(Sᵀx − τ).
       Vec6 g = ws.use_c ? nd.Hc : Vec6::Zero();
-      if (nd.rankG > 0) {
+      if (nd.rankG > 0 && j.nv == 1) {
+        pa += nd.gp.dot(nd.k) * nd.ias;
+        g -= (j.S.col(0).dot(pa) - tau[0]) * nd.gk;
+      } else if (nd.rankG > 0) {
         KVec y(j.nv);
         y.noalias() = nd.Gpinv * nd.k;
         pa.noalias() += nd.IaS * y;

@@ -40,7 +40,13 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
     auto qdd = ws.vdot.segment(j.idx_v, j.nv);
     const auto tau = ws.tau.segment(j.idx_v, j.nv);
     Vec6 w = abar;
-    if (nd.rankG > 0) {
+    if (nd.rankG > 0 && j.nv == 1) {
+      KVec r = nd.k;
+      r.noalias() -= nd.K * abar;
+      const double y = nd.gp.dot(r);
+      w += y * j.S.col(0);
+      qdd[0] = y;
+    } else if (nd.rankG > 0) {
       KVec r = nd.k;
       r.noalias() -= nd.K * abar;
       KVec y(j.nv);
@@ -69,7 +75,11 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
     if (nd.ncomp > 0) {
       KVec& mu = nd.comp[nd.ncomp - 1].mu;
       mu.setZero(nd.nK);
-      if (nd.rankG > 0) {
+      if (nd.rankG > 0 && j.nv == 1) {
+        const Vec6 s = j.S.col(0);
+        const double sIAa = p >= 0 ? nd.ias.dot(a) : s.dot(nd.IA * a);  // IA s kept (not at the root)
+        mu.noalias() += (sIAa + s.dot(nd.pA) - tau[0]) * nd.gp;
+      } else if (nd.rankG > 0) {
         KVec r(j.nv);
         if (nd.nf == 0 && p >= 0)  // Ia = IA, so Sᵀ IA a = (Ia S)ᵀ a, kept by the factor pass
           r.noalias() = nd.IaS.transpose() * a;

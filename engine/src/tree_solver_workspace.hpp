@@ -114,6 +114,10 @@ struct Node {
   Vec6 pA;                                ///< articulated bias before the joint
   Vec6 c;                                 ///< velocity-product acceleration v × S q̇
   Vec6 a;                                 ///< acceleration (gravity-shifted)
+  // One-DoF joint with its row resolved (the common case), kept compact:
+  KVec gp;                                ///< G⁺ᵀ = g/σ² (nK), g = K s
+  Vec6 gk;                                ///< GKᵀ = Kᵀ G⁺ᵀ (not at the root)
+  Vec6 ias;                               ///< IA s (not at the root)
   KVec hu;                                ///< reflector vector (U2Form::Reflector)
   KVec k;                                 ///< right sides of K
   KVec kpass;                             ///< right sides of the handed-up rows (on a_parent)
@@ -122,9 +126,9 @@ struct Node {
   // Factors (depend on q and the rows only).
   KRows K;                                ///< compressed rows, body frame
   KRows Kpass;                            ///< U2ᵀ K, this body's frame
-  SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK
-  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK
-  Mat6X IaS;                              ///< Ia S, Ia = IA − U D⁻¹ Uᵀ (ρ > 0, not the root)
+  SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK (nv > 1)
+  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK (nv > 1)
+  Mat6X IaS;                              ///< Ia S, Ia = IA − U D⁻¹ Uᵀ (ρ > 0, nv > 1, not the root)
   Mat6 IA;                                ///< articulated inertia before the joint
 
   // Free directions and general splits.
