@@ -324,6 +324,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     else
       splitGeneral(ws, j, p < 0, nd, H);
     if (p < 0) ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
+    if (nd.npass > 0) nd.kpc.noalias() = nd.Kpass * nd.c;  // for the bias pass
     if (p >= 0) {
       nd.Hc.noalias() = H * nd.c;  // the velocity-product term of the bias pass
       addCongruence(data.liMi[i], H, ws.nodes[p].IA);
@@ -397,7 +398,7 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
     }
     if (nd.npass > 0) {
       applyU2t(nd, nd.k, nd.kpass);
-      if (ws.use_c) nd.kpass.noalias() -= nd.Kpass * nd.c;
+      if (ws.use_c) nd.kpass -= nd.kpc;
     } else {
       nd.kpass.resize(0);
     }

@@ -121,6 +121,7 @@ struct Node {
   KVec hu;                                ///< reflector vector (U2Form::Reflector)
   KVec k;                                 ///< right sides of K
   KVec kpass;                             ///< right sides of the handed-up rows (on a_parent)
+  KVec kpc;                               ///< Kpass c, their velocity-product part
   KVec nu;                                ///< multipliers of the handed-up rows
 
   // Factors (depend on q and the rows only).
