@@ -18,8 +18,7 @@ namespace {
 /// Writes `rows` (r × 6) into rows at..at+r of the QR's stack.
 template <class Rows>
 void stackRows(PivotedQR& qr, int at, const Rows& rows) {
-  for (int c = 0; c < 6; ++c)
-    for (int r = 0; r < rows.rows(); ++r) qr.a[at + r][c] = rows(r, c);
+  for (int r = 0; r < rows.rows(); ++r) Eigen::Map<Vec6>(qr.a[at + r]) = rows.row(r).transpose();
 }
 
 /// Rank-revealing compression of the `nb` rows stacked in cp.f:
@@ -33,12 +32,11 @@ void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out) {
   cp.nrows = nb;
   cp.E.resize(nb);
   for (int r = 0; r < nb; ++r) {
-    double n2 = 0;
-    for (int c = 0; c < 6; ++c) n2 += qr.a[r][c] * qr.a[r][c];
-    const double n = std::sqrt(n2);
+    Eigen::Map<Vec6> row(qr.a[r]);
+    const double n = row.norm();
     const double e = n > o.rank_abs_tol ? 1.0 / n : 1.0;
     cp.E[r] = e;
-    for (int c = 0; c < 6; ++c) qr.a[r][c] *= e;
+    row *= e;
   }
   qr.factor(nb, o.rank_abs_tol, o.rank_rel_tol);
   const int rank = qr.rank;
@@ -52,8 +50,7 @@ void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out) {
 /// force transform and stacked at row `at` of the QR.
 void stackChildRows(const SE3& liMi, const KRows& rows, PivotedQR& qr, int at) {
   for (int r = 0; r < rows.rows(); ++r) {
-    const Vec6 w = liMi.actForce(rows.row(r).transpose());
-    for (int c = 0; c < 6; ++c) qr.a[at + r][c] = w[c];
+    Eigen::Map<Vec6>(qr.a[at + r]) = liMi.actForce(rows.row(r).transpose());
   }
 }
 
@@ -65,8 +62,7 @@ void stackBodyRows(const Data& data, const ConstraintData& cdata, const TreeBloc
   const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
   const SE3& oMi = data.oMi[tb.body];
   for (int r = 0; r < tb.rows; ++r) {
-    const Vec6 w = oMi.actInvForce(tb.sign * W.row(r).transpose());
-    for (int c = 0; c < 6; ++c) qr.a[at + r][c] = w[c];
+    Eigen::Map<Vec6>(qr.a[at + r]) = oMi.actInvForce(tb.sign * W.row(r).transpose());
   }
 }
 
