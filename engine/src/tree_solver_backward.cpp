@@ -138,36 +138,44 @@ bool freeSplit(TreeWorkspace& ws, Node& nd) {
 /// a symmetric rank-2 update; otherwise it is ABA's 1-DoF elimination.
 void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Mat6& H,
                  double& min_pivot) {
+  // Rows of K (row-major, nK × 6) as fixed-size 6-vectors: the products below
+  // are a handful of 6-wide dots and axpys, not Eigen's dynamic-size kernels.
   const int nK = nd.nK;
+  auto row = [&](int r) { return Eigen::Map<const Vec6>(nd.K.data() + 6 * r); };
   const Vec6 s = j.S.col(0);
-  double sigma = 0;
-  KVec g(nK);
-  if (nK > 0) {
-    g.noalias() = nd.K * s;
-    sigma = g.norm();
+  double g[6], sigma2 = 0;
+  for (int r = 0; r < nK; ++r) {
+    g[r] = row(r).dot(s);
+    sigma2 += g[r] * g[r];
   }
+  const double sigma = std::sqrt(sigma2);
   if (sigma > o.rank_abs_tol) {
     min_pivot = std::min(min_pivot, sigma);
     nd.rankG = 1;
     nd.npass = nK - 1;
     nd.nf = 0;
-    nd.gp = (1.0 / (sigma * sigma)) * g;  // G⁺ᵀ; nothing free: V2, S2 unused
+    nd.gp.resize(nK);  // G⁺ᵀ = g/σ²; nothing free: V2, S2 unused
+    for (int r = 0; r < nK; ++r) nd.gp[r] = g[r] / sigma2;
     if (nK > 1) {
       nd.u2form = U2Form::Reflector;
-      nd.hu = g / sigma;
+      nd.hu.resize(nK);
+      for (int r = 0; r < nK; ++r) nd.hu[r] = g[r] / sigma;
       nd.hu[0] += nd.hu[0] >= 0 ? 1.0 : -1.0;
       nd.hbeta = 2.0 / nd.hu.squaredNorm();
       // Kpass = U₂ᵀ K = rows 1… of H K = K − β u (uᵀ K).
-      const Eigen::Matrix<double, 1, 6> uK = nd.hu.transpose() * nd.K;
-      nd.Kpass = nd.K.bottomRows(nK - 1);
-      nd.Kpass.noalias() -= (nd.hbeta * nd.hu.tail(nK - 1)) * uK;
+      Vec6 uK = Vec6::Zero();
+      for (int r = 0; r < nK; ++r) uK += nd.hu[r] * row(r);
+      nd.Kpass.resize(nK - 1, 6);
+      for (int r = 1; r < nK; ++r)
+        Eigen::Map<Vec6>(nd.Kpass.data() + 6 * (r - 1)) = row(r) - (nd.hbeta * nd.hu[r]) * uK;
     } else {
       nd.u2form = U2Form::Identity;  // no rows left: U₂ is empty
       nd.Kpass.resize(0, 6);
     }
     if (root) return;  // H, gk and ias only serve the parent
     Vec6& gk = nd.gk;
-    gk.noalias() = nd.K.transpose() * nd.gp;
+    gk.setZero();
+    for (int r = 0; r < nK; ++r) gk += nd.gp[r] * row(r);
     const Vec6& w = nd.ias = nd.IA * s;  // nothing free: Ia = IA
     const Vec6 z = w - (0.5 * s.dot(w)) * gk;
     H = nd.IA;
