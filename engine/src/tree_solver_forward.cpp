@@ -41,9 +41,9 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
     const auto tau = ws.tau.segment(j.idx_v, j.nv);
     Vec6 w = abar;
     if (nd.rankG > 0 && j.nv == 1) {
-      KVec r = nd.k;
-      r.noalias() -= nd.K * abar;
-      const double y = nd.gp.dot(r);
+      double y = 0;  // G⁺(k − K ā), K's rows as fixed-size 6-vectors
+      for (int r = 0; r < nd.nK; ++r)
+        y += nd.gp[r] * (nd.k[r] - Eigen::Map<const Vec6>(nd.K.data() + 6 * r).dot(abar));
       w += y * j.S.col(0);
       qdd[0] = y;
     } else if (nd.rankG > 0) {
