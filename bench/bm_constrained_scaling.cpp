@@ -2,6 +2,10 @@
 // the O(n + m) tree solver against an unconstrained ABA on the same tree and
 // the dense KKT and Appell/Maggi references, for N = 8 … 1024 bodies.
 // Counters: ns_per_body (time per solve / bodies), bodies, rows.
+// BM_TreeOverAba interleaves one tree solve and one aba() on the same state in
+// every iteration and reports the ratio of their summed times: both see the
+// same machine state (clock, neighbours, caches), so the ratio stays stable
+// when the absolute times of separate runs drift.
 // The dense solvers stop at 256 bodies (O(n³); the comparison point is 256).
 // Each iteration evaluates nothing: the rows are evaluated once at a state
 // whose velocity satisfies them, and the solve alone is timed.
@@ -15,6 +19,8 @@
 #include "wheeled_snake.hpp"
 
 #include <benchmark/benchmark.h>
+
+#include <chrono>
 
 using namespace appell;
 
@@ -30,7 +36,7 @@ scenes::ScalingScene makeScene(int kind, int bodies) {
   }
 }
 
-enum class Which { Tree, Aba, Kkt, Appell };
+enum class Which { Tree, Aba, Kkt, Appell, TreeOverAba };
 
 void run(benchmark::State& st, Which which) {
   auto s = makeScene(static_cast<int>(st.range(0)), static_cast<int>(st.range(1)));
@@ -39,7 +45,8 @@ void run(benchmark::State& st, Which which) {
   std::unique_ptr<ConstrainedSolver> solver;
   switch (which) {
     case Which::Tree:
-    case Which::Aba: solver = makeTreeSolver(s.model, s.constraints); break;
+    case Which::Aba:
+    case Which::TreeOverAba: solver = makeTreeSolver(s.model, s.constraints); break;
     case Which::Kkt: solver = std::make_unique<KktSolver>(s.model, s.constraints); break;
     case Which::Appell: solver = std::make_unique<AppellSolver>(s.model, s.constraints); break;
   }
@@ -54,6 +61,20 @@ void run(benchmark::State& st, Which which) {
   ConstrainedResult out;
   if (which == Which::Aba) {
     for (auto _ : st) benchmark::DoNotOptimize(aba(s.model, data, s.q, v, tau).data());
+  } else if (which == Which::TreeOverAba) {
+    using Clock = std::chrono::steady_clock;
+    double tree_s = 0, aba_s = 0;
+    for (auto _ : st) {
+      const auto t0 = Clock::now();
+      solver->solve(s.model, data, s.constraints, cd, s.q, v, tau, out);
+      benchmark::DoNotOptimize(out.vdot.data());
+      const auto t1 = Clock::now();
+      benchmark::DoNotOptimize(aba(s.model, data, s.q, v, tau).data());
+      const auto t2 = Clock::now();
+      tree_s += std::chrono::duration<double>(t1 - t0).count();
+      aba_s += std::chrono::duration<double>(t2 - t1).count();
+    }
+    st.counters["tree_over_aba"] = tree_s / aba_s;
   } else {
     solver->solve(s.model, data, s.constraints, cd, s.q, v, tau, out);
     if (!out.ok) {
@@ -83,6 +104,7 @@ void BM_Tree(benchmark::State& st) { run(st, Which::Tree); }
 void BM_Aba(benchmark::State& st) { run(st, Which::Aba); }
 void BM_Kkt(benchmark::State& st) { run(st, Which::Kkt); }
 void BM_Appell(benchmark::State& st) { run(st, Which::Appell); }
+void BM_TreeOverAba(benchmark::State& st) { run(st, Which::TreeOverAba); }
 
 }  // namespace
 
@@ -91,3 +113,4 @@ BENCHMARK(BM_Tree)->Apply([](auto* b) { sizes(b, 1024); });
 BENCHMARK(BM_Aba)->Apply([](auto* b) { sizes(b, 1024); });
 BENCHMARK(BM_Kkt)->Apply([](auto* b) { sizes(b, 256); });
 BENCHMARK(BM_Appell)->Apply([](auto* b) { sizes(b, 256); });
+BENCHMARK(BM_TreeOverAba)->Apply([](auto* b) { sizes(b, 1024); });
