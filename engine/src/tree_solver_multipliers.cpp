@@ -61,8 +61,9 @@ void reactionForces(const Model& model, const Data& data, const ConstraintData& 
   for (const TreeBlock& tb : ws.blocks) {
     const RowBlock& blk = cdata.blocks[tb.constraint];
     const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
-    ws.fsub[tb.body].noalias() +=
-        tb.sign * W.transpose() * lambda.segment(tb.global, tb.rows);
+    Vec6& f = ws.fsub[tb.body];
+    for (int r = 0; r < tb.rows; ++r)  // W's rows as fixed-size 6-vectors
+      f += (tb.sign * lambda[tb.global + r]) * Eigen::Map<const Vec6>(W.data() + 6 * r);
   }
   reaction.setZero();
   for (const LoopRow& lr : ws.loops) {
@@ -78,7 +79,9 @@ void reactionForces(const Model& model, const Data& data, const ConstraintData& 
   for (int i = model.nbodies - 1; i >= 0; --i) {
     const int p = model.parent[i];
     const Joint& j = model.joints[i];
-    if (j.nv > 0)
+    if (j.nv == 1)
+      reaction[j.idx_v] += j.S.col(0).dot(data.oMi[i].actInvForce(ws.fsub[i]));
+    else if (j.nv > 0)
       reaction.segment(j.idx_v, j.nv).noalias() +=
           j.S.transpose() * data.oMi[i].actInvForce(ws.fsub[i]);
     if (p >= 0) ws.fsub[p] += ws.fsub[i];
