@@ -18,12 +18,11 @@
 
 namespace appell::detail {
 
-// Row stacks: at most 6 rows after compression, at most 12 while stacking.
+// Row stacks: at most 6 rows after compression, at most 12 while stacking
+// (stacked in PivotedQR's own storage).
 using KRows = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
 using KVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
-using BufRows = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 12, 6>;
 using BufVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 12, 1>;
-using BufMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12>;
 using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 
 /// One piece of a node's row stack: the output of the previous compression,
