@@ -1,8 +1,10 @@
 // Tree solver, backward passes (leaves → root). See docs/tree-solver.md.
 //
 // factorPass: everything that depends on the pose and the rows but not on the
-// right sides — row compression, the split of each joint by the SVD of K S,
-// and the articulated inertias with the particular/free coupling kept.
+// right sides — row compression, the split of each joint by K S (a norm and a
+// reflector for one DoF, the compression's triangular factor for a free
+// joint, an SVD otherwise), and the articulated inertias with the
+// particular/free coupling kept.
 // biasPass: the right sides — articulated bias forces and the right sides of
 // the compressed and handed-up rows; it can be replayed cheaply for the unit
 // solves of the loop closure and for the impulse solve.
@@ -16,8 +18,7 @@ namespace appell::detail {
 namespace {
 
 /// Writes `rows` (r × 6) into rows at..at+r of the QR's stack.
-template <class Rows>
-void stackRows(PivotedQR& qr, int at, const Rows& rows) {
+void stackRows(PivotedQR& qr, int at, const KRows& rows) {
   for (int r = 0; r < rows.rows(); ++r) Eigen::Map<Vec6>(qr.a[at + r]) = rows.row(r).transpose();
 }
 
