@@ -94,11 +94,7 @@ TEST(TreeSolver, FewRowsLeaveMostJointsAsPlainAba) {
   // and with no rows at all it must equal ABA to round-off.
   std::mt19937 rng(13);
   for (bool floating : {false, true}) {
-    System s;
-    s.model = randomTree(30, floating, rng);
-    s.q = randomConfiguration(s.model, rng);
-    s.v = randomVector(s.model.nv, rng);
-    s.tau = randomVector(s.model.nv, rng);
+    System s = randomState(30, floating, rng);
     Data data(s.model);
     const VecX ddq = aba(s.model, data, s.q, s.v, s.tau);
     ConstraintList none;
@@ -164,11 +160,7 @@ TEST(TreeSolver, SingularPoseOfAStretchedArm) {
 TEST(TreeSolver, InconsistentDuplicateIsAnErrorNamingTheConstraints) {
   std::mt19937 rng(15);
   for (bool floating : {false, true}) {
-    System s;
-    s.model = randomTree(12, floating, rng);
-    s.q = randomConfiguration(s.model, rng);
-    s.v = randomVector(s.model.nv, rng);
-    s.tau = randomVector(s.model.nv, rng);
+    System s = randomState(12, floating, rng);
     // A row on body 7 and the same row, scaled, in a second constraint there;
     // an unrelated constraint on body 3.
     Rows K1(2, 6), K2(1, 6), K3(1, 6);

@@ -224,12 +224,19 @@ inline void addRandomRows(System& s, std::mt19937& rng, const RowRecipe& recipe)
   }
 }
 
-inline System randomSystem(int n, bool floating, std::mt19937& rng, const RowRecipe& recipe) {
+/// A random tree of n bodies at a random state (q, v, τ), no rows yet.
+inline System randomState(int n, bool floating, std::mt19937& rng, double v_scale = 1.0,
+                          double tau_scale = 1.0) {
   System s;
   s.model = randomTree(n, floating, rng);
   s.q = randomConfiguration(s.model, rng);
-  s.v = randomVector(s.model.nv, rng, 1.5);
-  s.tau = randomVector(s.model.nv, rng, 2.0);
+  s.v = randomVector(s.model.nv, rng, v_scale);
+  s.tau = randomVector(s.model.nv, rng, tau_scale);
+  return s;
+}
+
+inline System randomSystem(int n, bool floating, std::mt19937& rng, const RowRecipe& recipe) {
+  System s = randomState(n, floating, rng, 1.5, 2.0);
   addRandomRows(s, rng, recipe);
   makeConsistent(s, rng);
   return s;

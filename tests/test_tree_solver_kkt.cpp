@@ -8,20 +8,29 @@
 using namespace appell;
 using namespace appell::test;
 
+namespace {
+
+/// Both solvers on the rows of s at its state.
+void solveBoth(const System& s, ConstrainedResult& ko, ConstrainedResult& to) {
+  const ConstraintList list = s.list();
+  Data data(s.model);
+  ConstraintData cd(s.model, list);
+  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  KktSolver kkt(s.model, list);
+  TreeSolver tree(s.model, list);
+  kkt.solve(s.model, data, list, cd, s.q, s.v, s.tau, ko);
+  tree.solve(s.model, data, list, cd, s.q, s.v, s.tau, to);
+}
+
+}  // namespace
+
 TEST(TreeSolver, AgreesWithDenseKkt) {
   std::mt19937 rng(17);
   for (int n : {3, 10, 25}) {
     for (bool floating : {false, true}) {
       const System s = randomSystem(n, floating, rng, RowRecipe{0.2, 0.2, 2});
-      const ConstraintList list = s.list();
-      Data data(s.model);
-      ConstraintData cd(s.model, list);
-      evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-      KktSolver kkt(s.model, list);
-      TreeSolver tree(s.model, list);
       ConstrainedResult ko, to;
-      kkt.solve(s.model, data, list, cd, s.q, s.v, s.tau, ko);
-      tree.solve(s.model, data, list, cd, s.q, s.v, s.tau, to);
+      solveBoth(s, ko, to);
       ASSERT_TRUE(ko.ok) << ko.error;
       ASSERT_TRUE(to.ok) << to.error;
       EXPECT_LT(relErr(to.vdot, ko.vdot), 1e-10) << "n=" << n;
@@ -37,11 +46,7 @@ TEST(TreeSolver, AgreesWithDenseKkt) {
 
 TEST(TreeSolver, KktAgreesOnInconsistency) {
   std::mt19937 rng(19);
-  System s;
-  s.model = randomTree(12, true, rng);
-  s.q = randomConfiguration(s.model, rng);
-  s.v = randomVector(s.model.nv, rng);
-  s.tau = randomVector(s.model.nv, rng);
+  System s = randomState(12, true, rng);
   Rows K1(2, 6), K2(1, 6);
   K1.row(0) = randomRow(rng).transpose();
   K1.row(1) = randomRow(rng).transpose();
@@ -50,15 +55,8 @@ TEST(TreeSolver, KktAgreesOnInconsistency) {
   s.local.push_back(std::make_shared<LocalRows>("second", 7, K2));
   makeConsistent(s, rng);
   s.local[1]->kappa()[0] += 1e-3;
-  const ConstraintList list = s.list();
-  Data data(s.model);
-  ConstraintData cd(s.model, list);
-  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-  KktSolver kkt(s.model, list);
-  TreeSolver tree(s.model, list);
   ConstrainedResult ko, to;
-  kkt.solve(s.model, data, list, cd, s.q, s.v, s.tau, ko);
-  tree.solve(s.model, data, list, cd, s.q, s.v, s.tau, to);
+  solveBoth(s, ko, to);
   EXPECT_FALSE(ko.ok);
   EXPECT_FALSE(to.ok);
 }
