@@ -89,6 +89,80 @@ TEST(TreeSolver, DuplicatedScaledAndImmobileRows) {
   }
 }
 
+TEST(TreeSolver, RowsAJointBarelyMovesAreHandedUpWithCompliance) {
+  // A row whose own joint moves it with a small pivot σ, while an ancestor
+  // moves it well. Resolving it at the small pivot would lose ~eps/σ⁴; the
+  // solver hands it up with its compliance instead, and must match the dense
+  // solvers with no refinement. (Below σ ≈ 10⁻⁵ the problem itself is ill
+  // conditioned: the dense KKT solver in double then misses the long-double
+  // reference by ~10⁻¹⁰ too.)
+  std::mt19937 rng(17);
+  int checked = 0;
+  for (double sigma : {3e-2, 1e-3, 1e-4}) {
+    for (int n : {4, 9, 20}) {
+      for (bool floating : {false, true}) {
+        for (int rep = 0; rep < 3; ++rep) {
+          System s = randomSystem(n, floating, rng, RowRecipe{0.2, 0.2, 1});
+          for (int i = n - 1, added = 0; i > 0 && added < 3; --i) {
+            if (s.model.joints[i].nv != 1) continue;
+            Rows K(1, 6);
+            K.row(0) = weakRow(s.model, i, sigma, rng).transpose();
+            s.local.push_back(std::make_shared<LocalRows>("weak@" + std::to_string(i), i, K));
+            ++added;
+          }
+          makeConsistent(s, rng);
+          const Compared c = compare(s);
+          ++checked;
+          EXPECT_LT(c.vdot, 1e-10) << "sigma=" << sigma << " n=" << n << " rep=" << rep;
+          EXPECT_LT(c.reaction, 1e-10) << "sigma=" << sigma << " n=" << n << " rep=" << rep;
+          EXPECT_EQ(c.rank, c.ref_rank) << "sigma=" << sigma << " n=" << n;
+          if (c.full_rank) {
+            EXPECT_LT(c.lambda, 1e-8) << "sigma=" << sigma << " n=" << n;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 54);
+}
+
+TEST(TreeSolver, CompliantRowBeyondTheParentsSixRows) {
+  // A free body with six rows of its own and a child whose row its revolute
+  // joint barely moves: seven rows meet at the free body, so one combination
+  // has no acceleration part there and is fixed by the child's compliance
+  // alone. A has full rank (7 rows, 7 DoF): v̇ and λ are unique. (All of v̇
+  // hangs on the weak row: the problem's conditioning grows like 1/σ², and by
+  // σ = 10⁻³ the dense KKT solver in double misses the long-double reference
+  // by 6·10⁻¹¹, by 4·10⁻⁹ at 10⁻⁴.)
+  std::mt19937 rng(19);
+  for (double sigma : {2e-2, 5e-3}) {
+    for (int rep = 0; rep < 4; ++rep) {
+      ModelBuilder b;
+      b.addBody("free", -1, randomPlacement(rng), JointType::Floating, Vec3::UnitZ(),
+                randomInertia(rng));
+      b.addBody("leaf", 0, randomPlacement(rng), JointType::Revolute, randomUnit(rng),
+                randomInertia(rng));
+      System s;
+      s.model = b.build();
+      s.q = randomConfiguration(s.model, rng);
+      s.v = randomVector(s.model.nv, rng);
+      s.tau = randomVector(s.model.nv, rng);
+      Rows K6(6, 6), K1(1, 6);
+      for (int r = 0; r < 6; ++r) K6.row(r) = randomRow(rng).transpose();
+      K1.row(0) = weakRow(s.model, 1, sigma, rng).transpose();
+      s.local.push_back(std::make_shared<LocalRows>("six", 0, K6));
+      s.local.push_back(std::make_shared<LocalRows>("weak", 1, K1));
+      makeConsistent(s, rng);
+      const Compared c = compare(s);
+      EXPECT_TRUE(c.full_rank);
+      EXPECT_LT(c.vdot, 1e-10) << "sigma=" << sigma;
+      EXPECT_LT(c.reaction, 1e-10) << "sigma=" << sigma;
+      EXPECT_LT(c.lambda, 1e-8) << "sigma=" << sigma;
+      EXPECT_EQ(c.rank, 7);
+    }
+  }
+}
+
 TEST(TreeSolver, FewRowsLeaveMostJointsAsPlainAba) {
   // One row on one leaf: the solver must equal ABA + one rank-one correction,
   // and with no rows at all it must equal ABA to round-off.

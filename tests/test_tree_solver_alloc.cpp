@@ -2,7 +2,7 @@
 // result vectors have their sizes: every allocation of this executable is
 // counted (operator new and malloc & co., which Eigen uses), and the count
 // over repeated solves must be zero — on random trees with redundant rows,
-// with loop rows, and on a pose that triggers refinement.
+// with loop rows, and with rows handed up with their compliance.
 #include "test_tree_solver_common.hpp"
 
 #include <gtest/gtest.h>
@@ -46,6 +46,24 @@ TEST(TreeSolverAllocations, NoneOnRandomTrees) {
   std::mt19937 rng(31);
   for (bool floating : {false, true}) {
     System s = randomSystem(30, floating, rng, RowRecipe{0.3, 0.3, 3});
+    expectNoAllocation(s);
+  }
+}
+
+TEST(TreeSolverAllocations, NoneWithRowsHandedUpWithCompliance) {
+  // Rows the bodies' own joints barely move (tree_solver_soft.cpp), some on a
+  // free body that already has six rows (compliant dropped combinations).
+  std::mt19937 rng(33);
+  for (bool floating : {false, true}) {
+    System s = randomSystem(20, floating, rng, RowRecipe{0.3, 0.3, 2});
+    for (int i = 19, added = 0; i > 0 && added < 4; --i) {
+      if (s.model.joints[i].nv != 1) continue;
+      Rows K(1, 6);
+      K.row(0) = weakRow(s.model, i, 1e-3, rng).transpose();
+      s.local.push_back(std::make_shared<LocalRows>("weak" + std::to_string(i), i, K));
+      ++added;
+    }
+    makeConsistent(s, rng);
     expectNoAllocation(s);
   }
 }

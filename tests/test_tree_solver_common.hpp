@@ -242,6 +242,16 @@ inline System randomSystem(int n, bool floating, std::mt19937& rng, const RowRec
   return s;
 }
 
+/// A unit row on body i that the body's own one-DoF joint moves with pivot
+/// exactly σ: σ s + √(1 − σ²) w with w ⊥ s a random direction (which the
+/// ancestors' joints generally move well).
+inline Vec6 weakRow(const Model& model, int i, double sigma, std::mt19937& rng) {
+  const Vec6 s = model.joints[i].S.col(0).normalized();
+  Vec6 w = randomRow(rng);
+  w -= s.dot(w) * s;
+  return sigma * s + std::sqrt(1 - sigma * sigma) * w.normalized();
+}
+
 inline double relErr(const VecX& a, const VecX& b) {
   return (a - b).norm() / std::max(1.0, b.norm());
 }

@@ -71,10 +71,10 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   ws.vdot = VecX::Zero(model.nv);
   ws.lambda = VecX::Zero(ws.m);
   ws.fsub.assign(model.nbodies, Vec6::Zero());
+  ws.a0.assign(model.nbodies, Vec6::Zero());
   ws.vdot_acc = VecX::Zero(model.nv);
   ws.lambda_acc = VecX::Zero(ws.m);
   ws.resid_f = VecX::Zero(model.nv);
-  ws.a0.assign(model.nbodies, Vec6::Zero());
   const int k = static_cast<int>(ws.loops.size());
   if (k > 0) {
     ws.W = MatX::Zero(model.nv, k);
@@ -99,16 +99,6 @@ void checkSizes(const Model& model, const ConstraintData& cdata, const detail::T
   if (model.nbodies != ws.nbodies || model.nv != ws.nv || cdata.m != ws.m)
     throw std::invalid_argument(
         "TreeSolver: the model or constraint set differs from the one the solver was built for");
-}
-
-/// Refinement steps for the smallest pivot the factor pass divided by: the
-/// recursion's error grows like eps/σ⁴ (tree_solver_refine.cpp), each step
-/// squares the relative error.
-/// Loop rows always get one step: their unit responses are summed through a
-/// Schur complement whose error is not bounded by the tree pivots alone.
-int refinementSteps(double min_pivot, bool loops) {
-  const int s = min_pivot < 5e-4 ? 3 : min_pivot < 5e-3 ? 2 : min_pivot < 5e-2 ? 1 : 0;
-  return loops ? std::max(s, 1) : s;
 }
 
 /// Velocity products and bias forces of the current state (ABA's first pass).
@@ -163,7 +153,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     return;
   }
   ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;
-  for (int s = refinementSteps(ws.min_pivot, !ws.loops.empty()); s > 0; --s)
+  for (int s = ws.loop_refinement; s > 0; --s)
     detail::refine(model, data, cdata, ws, q, v, tau, false);
   out.vdot = ws.vdot;
   out.lambda = ws.lambda;
@@ -205,7 +195,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     ws.last_error = detail::describeFailure(model, data, ws);
     return false;
   }
-  for (int s = refinementSteps(ws.min_pivot, !ws.loops.empty()); s > 0; --s)
+  for (int s = ws.loop_refinement; s > 0; --s)
     detail::refine(model, data, cdata, ws, q, v, ws.tau, true);
   v += ws.vdot;
   impulse = -ws.lambda;  // the shared convention: v⁺ = v − M⁻¹Aᵀμ

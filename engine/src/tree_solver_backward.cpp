@@ -94,10 +94,9 @@ void addCongruence(const SE3& M, const Mat6& H, Mat6& out) {
 /// minimised over all of null K, so v̇ is the constrained minimiser, and
 /// μ = G⁺ᵀ(Sᵀf − τ) is exact because the force balance along V₂ puts Sᵀf − τ
 /// in the range of Gᵀ. σ_min(K) ≥ σ_min(R₁₁) ≥ 1/‖R₁₁⁻¹‖_F: when that bound is
-/// above the first refinement threshold (5·10⁻², far above the rank
-/// tolerances: ‖K‖ ≤ √12) the split is well conditioned and the refinement
-/// decision is the SVD's; otherwise returns false and the caller takes the SVD.
-bool freeSplit(TreeWorkspace& ws, Node& nd) {
+/// above kWeakPivot the SVD would resolve every row too; otherwise returns
+/// false and the caller takes the SVD.
+bool freeSplit(Node& nd) {
   const int n = nd.nK;
   const int* perm = nd.comp[nd.ncomp - 1].f.perm;
   double R[6][6], Ri[6][6] = {};
@@ -112,8 +111,7 @@ bool freeSplit(TreeWorkspace& ws, Node& nd) {
       fro += Ri[r][c] * Ri[r][c];
     }
   const double lb = 1.0 / std::sqrt(fro);
-  if (!(lb > 5e-2)) return false;
-  ws.min_pivot = std::min(ws.min_pivot, lb);
+  if (!(lb > kWeakPivot)) return false;
   nd.Gpinv.setZero(6, n);
   nd.V2.setZero(6, 6 - n);
   for (int r = 0; r < n; ++r) {
@@ -137,8 +135,8 @@ bool freeSplit(TreeWorkspace& ws, Node& nd) {
 ///   H = Pᵀ IA P = IA − (gk zᵀ + z gkᵀ),  P = 1 − s gkᵀ, gk = Kᵀ g / σ²,
 ///   z = IA s − ½ (sᵀ IA s) gk,
 /// a symmetric rank-2 update; otherwise it is ABA's 1-DoF elimination.
-void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Mat6& H,
-                 double& min_pivot) {
+/// Returns false, leaving the split to splitSoft, when 0 < σ < kWeakPivot.
+bool splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Mat6& H) {
   // Rows of K (row-major, nK × 6) as fixed-size 6-vectors: the products below
   // are a handful of 6-wide dots and axpys, not Eigen's dynamic-size kernels.
   const int nK = nd.nK;
@@ -150,8 +148,8 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Ma
     sigma2 += g[r] * g[r];
   }
   const double sigma = std::sqrt(sigma2);
+  if (sigma > o.rank_abs_tol && sigma < kWeakPivot) return false;  // compliant rows
   if (sigma > o.rank_abs_tol) {
-    min_pivot = std::min(min_pivot, sigma);
     nd.rankG = 1;
     nd.npass = nK - 1;
     nd.nf = 0;
@@ -173,7 +171,7 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Ma
       nd.u2form = U2Form::Identity;  // no rows left: U₂ is empty
       nd.Kpass.resize(0, 6);
     }
-    if (root) return;  // H, gk and ias only serve the parent
+    if (root) return true;  // H, gk and ias only serve the parent
     Vec6& gk = nd.gk;
     gk.setZero();
     for (int r = 0; r < nK; ++r) gk += nd.gp[r] * row(r);
@@ -197,17 +195,19 @@ void splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Ma
     H = nd.IA;
     H.noalias() -= (Dinv * U) * U.transpose();
   }
+  return true;
 }
 
 /// Any other joint: a free joint's split from the compression's R₁₁ when well
 /// conditioned, otherwise the SVD of G = K S; then the free part eliminated
-/// as in ABA and H = Pᵀ Ia P.
-void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H) {
+/// as in ABA and H = Pᵀ Ia P. Returns false, leaving the split to splitSoft,
+/// when a kept singular value is below kWeakPivot.
+bool splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H) {
   const SolverOptions& o = ws.options;
   const int nv = j.nv, nK = nd.nK;
   int rho = 0;
   nd.u2form = U2Form::Explicit;
-  if (nK > 0 && j.type == JointType::Floating && freeSplit(ws, nd)) {
+  if (nK > 0 && j.type == JointType::Floating && freeSplit(nd)) {
     rho = nK;
   } else if (nK > 0 && nv > 0) {
     const SmallMat G = nd.K * j.S;
@@ -215,7 +215,7 @@ void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& 
     const auto& sv = ws.svd.singularValues();
     const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * sv(0));
     while (rho < sv.size() && sv(rho) > thr) ++rho;
-    if (rho > 0) ws.min_pivot = std::min(ws.min_pivot, sv(rho - 1));
+    if (rho > 0 && sv(rho - 1) < kWeakPivot) return false;  // compliant rows
     const auto& Um = ws.svd.matrixU();
     const auto& Vm = ws.svd.matrixV();
     if (rho > 0)
@@ -251,7 +251,7 @@ void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& 
     const SmallMat D = nd.S2.transpose() * nd.U;
     nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
   }
-  if (root) return;  // H, GK and IaS only serve the parent
+  if (root) return true;  // H, GK and IaS only serve the parent
   Mat6 Ia = nd.IA;
   if (nd.nf > 0) Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
   if (rho > 0) {
@@ -267,6 +267,7 @@ void splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& 
   } else {
     H = Ia;
   }
+  return true;
 }
 
 }  // namespace
@@ -276,7 +277,6 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
   const SolverOptions& o = ws.options;
   for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].IA = model.spatial_inertia[i];
   ws.redundant = 0;
-  ws.min_pivot = 1;
 
   for (int i = model.nbodies - 1; i >= 0; --i) {
     Node& nd = ws.nodes[i];
@@ -294,7 +294,10 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     auto compressStack = [&]() {
       compress(o, *cur, nb, nd.K);
       nd.nK = cur->rank;
-      ws.redundant += nb - cur->rank;
+      bool soft = false;
+      for (int s = 0; s < cur->nseg; ++s) soft |= softSegment(ws, nd, nd.ncomp, cur->seg[s]);
+      cur->soft = false;
+      ws.redundant += soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
       cur = &nd.comp[++nd.ncomp];
       cur->nseg = 0;
     };
@@ -324,10 +327,11 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     //    part z is eliminated as in ABA, and the parent sees H = Pᵀ Ia P — the
     //    particular/free coupling the constrained-LQR equations drop.
     Mat6 H;
-    if (j.nv == 1)
-      splitOneDof(o, j, p < 0, nd, H, ws.min_pivot);
-    else
-      splitGeneral(ws, j, p < 0, nd, H);
+    nd.soft = false;
+    nd.softpass = false;
+    const bool soft_rows = nd.ncomp > 0 && nd.comp[nd.ncomp - 1].soft;
+    if (soft_rows || !(j.nv == 1 ? splitOneDof(o, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))
+      splitSoft(ws, j, p < 0, nd, H);
     if (p < 0) ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
     if (nd.npass > 0) nd.kpc.noalias() = nd.Kpass * nd.c;  // for the bias pass
     if (p >= 0) {
@@ -358,6 +362,15 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
         rmax = std::max(rmax, std::abs(r[k]));
       }
       applyQt(cp, r);
+      const double tol = o.consistency_tol * std::max(1.0, rmax);
+      if (cp.soft) {
+        double res;
+        if (!softCompressionRhs(cp, r, tol, res) && check) {
+          ws.failure = {true, i, e, res};
+          return false;
+        }
+        continue;
+      }
       cp.rhs.resize(cp.rank);
       for (int k = 0; k < cp.rank; ++k) cp.rhs[k] = r[k];
       if (check && cp.nrows > cp.rank) {
@@ -365,7 +378,7 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
         // sides must be the same combinations, or no acceleration satisfies them.
         double res = 0;
         for (int k = cp.rank; k < cp.nrows; ++k) res = std::max(res, std::abs(r[k]));
-        if (res > o.consistency_tol * std::max(1.0, rmax)) {
+        if (res > tol) {
           ws.failure = {true, i, e, res};
           return false;
         }
@@ -376,6 +389,17 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
     else
       nd.k.resize(0);
 
+    if (nd.soft) {
+      Vec6 pa;
+      softBias(j, nd, ws.tau, pa);
+      if (p >= 0) {
+        if (ws.use_c) pa += nd.Hc;
+        ws.nodes[p].pA += data.liMi[i].actForce(pa);
+      }
+      nd.kpass = nd.kv.head(nd.npass);
+      if (ws.use_c && nd.npass > 0) nd.kpass -= nd.kpc;
+      continue;
+    }
     const auto tau = ws.tau.segment(j.idx_v, j.nv);
     if (nd.nf > 0) {
       if (nd.rankG > 0)

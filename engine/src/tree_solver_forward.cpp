@@ -36,6 +36,12 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
       }
     }
 
+    if (nd.soft) {
+      softForward(j, nd, abar, ws.vdot);
+      unrollNode(ws, i, nd.ncomp - 1, ws.lambda);
+      continue;
+    }
+
     // q̈ = G⁺(k − K ā) + V₂ z,   z = D⁻¹(u − Uᵀ w),   w = ā + S G⁺(k − K ā).
     auto qdd = ws.vdot.segment(j.idx_v, j.nv);
     const auto tau = ws.tau.segment(j.idx_v, j.nv);

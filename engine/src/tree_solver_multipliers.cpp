@@ -48,6 +48,7 @@ void unrollNode(TreeWorkspace& ws, int body, int from, VecX& lambda) {
     const Compression& cp = nd.comp[e];
     BufVec lam(cp.nrows);
     for (int k = 0; k < cp.nrows; ++k) lam[k] = k < cp.rank ? cp.mu[k] : 0.0;
+    if (cp.soft) softDroppedMultipliers(cp, lam);
     applyQ(cp, lam);
     for (int k = 0; k < cp.nrows; ++k) lam[k] *= cp.E[k];
     distribute(ws, nd, e, lam, lambda);

@@ -1,14 +1,14 @@
 // Tree solver, right sides of the loop rows and iterative refinement.
 //
-// Why refinement: a joint that resolves a row it can only weakly move (the
-// smallest kept singular value σ of K S is small) hands its parent a stiff
-// term of size 1/σ² (Pᵀ Ia P with |P| ~ 1/σ); the recursion stays exact in
-// exact arithmetic but loses about eps/σ⁴ in floating point — 1e-5 at
-// σ ≈ 1e-3, where the dense solvers lose nothing. One step of iterative
-// refinement on the KKT residual (Wilkinson; Higham, "Accuracy and Stability
-// of Numerical Algorithms", ch. 12) reuses the factorization — one RNEA plus
-// one right-side replay, O(n + m) — and squares that error away. It runs only
-// when the factor pass saw such a pivot, so well-conditioned trees pay nothing.
+// The tree recursion itself needs no refinement: rows a joint can barely move
+// are handed up with their compliance (tree_solver_soft.cpp) instead of being
+// resolved by a small pivot. Loop rows are different: their Schur complement
+// B M_c⁻¹ Bᵀ is formed from unit solves and squares the conditioning of the
+// loop rows, so when it is ill conditioned (cond > 10⁴, tree_solver_loops.cpp)
+// one step of iterative refinement on the KKT residual (Wilkinson; Higham,
+// "Accuracy and Stability of Numerical Algorithms", ch. 12) restores the dense
+// solvers' accuracy. It reuses the factorization — one RNEA, O(n + m) row
+// residuals and one replay with the k unit responses — and runs only then.
 #include <appell/dynamics.hpp>
 #include <appell/kinematics.hpp>
 

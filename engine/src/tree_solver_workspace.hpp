@@ -24,6 +24,12 @@ using KRows = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
 using KVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using BufVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 12, 1>;
 using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+using StackMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12>;
+
+/// A kept singular value of K S below this (rows equilibrated, S unit) is a
+/// joint that can barely move its rows: the rows are not resolved there but
+/// handed up with their compliance (tree_solver_soft.cpp).
+constexpr double kWeakPivot = 5e-2;
 
 /// One piece of a node's row stack: the output of the previous compression,
 /// one constraint's own rows, or one child's unresolved rows.
@@ -47,6 +53,18 @@ struct Compression {
   std::array<Segment, 13> seg;
   KVec rhs;                    ///< kept right sides (bias pass)
   KVec mu;                     ///< multipliers of the kept rows (forward pass)
+
+  // Compliant rows (tree_solver_soft.cpp): a stacked segment carried a
+  // compliance Φ = F Fᵀ (kept as its square-root factor F), so the dropped
+  // combinations (K part ≈ 0) may still involve multipliers:
+  // Φ_dk μ_k + Φ_dd μ_d = r_d,  F_d = U_d Σ_d W_dᵀ.
+  bool soft = false;
+  int nelim = 0;               ///< dropped directions with compliance (eliminated here)
+  SmallMat F;                  ///< rank × rank factor of the kept rows' compliance
+  StackMat Ud;                 ///< left singular vectors of F_d: eliminated, then redundant
+  BufVec sInv;                 ///< 1/Σ_e of the eliminated directions
+  StackMat FkWe;               ///< F_k W_e (rank × nelim)
+  BufVec rd;                   ///< dropped right sides Q₂ᵀ E r of the last bias pass
 };
 
 /// A constraint whose rows act on one body of the tree.
@@ -138,6 +156,18 @@ struct Node {
   SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
   KVec u;                                 ///< V2ᵀ τ − S2ᵀ pA
 
+  // Compliant elimination (tree_solver_soft.cpp): the joint is eliminated as
+  // in ABA with the rows carried, K' a − Φ' λ = k'; directions of Φ' large
+  // enough are resolved here, the rest handed up with their compliance.
+  bool soft = false;
+  bool softpass = false;                  ///< some handed-up row has compliance > 0
+  KVec fpass;                             ///< √compliance of the handed-up rows (diagonal)
+  SmallMat GD;                            ///< G D⁻¹ (nK × nv), G = K S
+  SmallMat Vphi;                          ///< eigenvectors of Φ': handed up, then resolved
+  KRows Kel;                              ///< resolved rows V₁ᵀ K'
+  KVec lamInv;                            ///< 1/Λ₁
+  KVec kv;                                ///< Vphiᵀ k' (bias pass)
+
   std::vector<Segment> groups;            ///< own blocks, then children
   std::vector<Compression> comp;          ///< sized groups.size() + 1
 };
@@ -197,10 +227,12 @@ struct TreeWorkspace {
   VecX vdot, lambda;
   int redundant = 0;
   Failure failure;
-  /// Smallest singular value of K S kept by any joint (rows equilibrated, S
-  /// unit): the pivots the recursion divides by. Decides refinement steps.
-  double min_pivot = 1;
+  /// Refinement steps the loop closure asks for: its Schur complement squares
+  /// the conditioning of the loop rows (tree_solver_refine.cpp).
+  int loop_refinement = 0;
   VecX vdot_acc, lambda_acc, resid_f;
+  /// Compliance factors (tree_solver_soft.cpp): F' of a joint, F_d, F_k of a stack.
+  Eigen::JacobiSVD<StackMat, Eigen::ColPivHouseholderQRPreconditioner> svd12;
 
   // Loop closure: k unit solves and the Schur complement.
   MatX W;                                 ///< nv × k, response to each loop row's force
@@ -261,6 +293,26 @@ void loopTargets(const Model& model, const Data& data, const ConstraintData& cda
 /// factorization (tree_solver_refine.cpp). `impulse`: the projection problem.
 void refine(const Model& model, Data& data, const ConstraintData& cdata, TreeWorkspace& ws,
             const VecX& q, const VecX& v, const VecX& tau, bool impulse);
+
+// Compliant rows (tree_solver_soft.cpp).
+/// After compress(): the stack's compliance factor carried through Q, the
+/// dropped combinations with compliance eliminated. Returns the truly
+/// redundant count.
+int softCompress(TreeWorkspace& ws, int body, int e);
+/// Whether a segment of a stack carries compliance.
+bool softSegment(const TreeWorkspace& ws, const Node& nd, int e, const Segment& g);
+/// Joint split with rows carried (ABA elimination, then Φ' split); H for the parent.
+void splitSoft(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H);
+/// Right sides through a compliant compression; false if the redundant part
+/// is inconsistent (residual in `res`).
+bool softCompressionRhs(Compression& cp, const BufVec& t, double tol, double& res);
+/// Multipliers of a compliant compression's dropped rows, into lam[rank…].
+void softDroppedMultipliers(const Compression& cp, BufVec& lam);
+/// Bias pass of a compliant node: its gradient contribution g for the parent
+/// (without H c) and its handed-up right sides.
+void softBias(const Joint& j, Node& nd, const VecX& tau, Vec6& pa);
+/// Forward pass of a compliant node: q̈, a, and the multipliers of its rows.
+void softForward(const Joint& j, Node& nd, const Vec6& abar, VecX& vdot);
 /// "…" message naming the constraints involved in the inconsistency of ws.failure.
 std::string describeFailure(const Model& model, const Data& data, TreeWorkspace& ws);
 
