@@ -108,6 +108,13 @@ std::string describeFailure(const Model& model, const Data& data, TreeWorkspace&
     BufVec lam = r;
     applyQt(cp, lam);
     lam.head(cp.rank).setZero();  // Q₂ t₂: the dropped combinations only
+    if (cp.soft) {  // … and of those, only the redundant ones (not fixed by compliance)
+      const int nd_ = cp.nrows - cp.rank, nz = nd_ - cp.nelim;
+      const auto Uz = cp.Ud.rightCols(nz);
+      BufVec y(nz);
+      y.noalias() = Uz.transpose() * lam.tail(nd_);
+      lam.tail(nd_).noalias() = Uz * y;
+    }
     applyQ(cp, lam);
     lam.array() *= cp.E.array();
     distribute(ws, nd, f.comp, lam, cert);
