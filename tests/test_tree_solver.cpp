@@ -103,13 +103,7 @@ TEST(TreeSolver, RowsAJointBarelyMovesAreHandedUpWithCompliance) {
       for (bool floating : {false, true}) {
         for (int rep = 0; rep < 3; ++rep) {
           System s = randomSystem(n, floating, rng, RowRecipe{0.2, 0.2, 1});
-          for (int i = n - 1, added = 0; i > 0 && added < 3; --i) {
-            if (s.model.joints[i].nv != 1) continue;
-            Rows K(1, 6);
-            K.row(0) = weakRow(s.model, i, sigma, rng).transpose();
-            s.local.push_back(std::make_shared<LocalRows>("weak@" + std::to_string(i), i, K));
-            ++added;
-          }
+          addWeakRows(s, 3, sigma, rng);
           makeConsistent(s, rng);
           const Compared c = compare(s);
           ++checked;

@@ -56,13 +56,7 @@ TEST(TreeSolverAllocations, NoneWithRowsHandedUpWithCompliance) {
   std::mt19937 rng(33);
   for (bool floating : {false, true}) {
     System s = randomSystem(20, floating, rng, RowRecipe{0.3, 0.3, 2});
-    for (int i = 19, added = 0; i > 0 && added < 4; --i) {
-      if (s.model.joints[i].nv != 1) continue;
-      Rows K(1, 6);
-      K.row(0) = weakRow(s.model, i, 1e-3, rng).transpose();
-      s.local.push_back(std::make_shared<LocalRows>("weak" + std::to_string(i), i, K));
-      ++added;
-    }
+    addWeakRows(s, 4, 1e-3, rng);
     makeConsistent(s, rng);
     expectNoAllocation(s);
   }

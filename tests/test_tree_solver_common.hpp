@@ -252,6 +252,17 @@ inline Vec6 weakRow(const Model& model, int i, double sigma, std::mt19937& rng) 
   return sigma * s + std::sqrt(1 - sigma * sigma) * w.normalized();
 }
 
+/// Adds one weak row (weakRow, pivot σ) on each of the last `count` one-DoF bodies.
+inline void addWeakRows(System& s, int count, double sigma, std::mt19937& rng) {
+  for (int i = s.model.nbodies - 1, added = 0; i > 0 && added < count; --i) {
+    if (s.model.joints[i].nv != 1) continue;
+    Rows K(1, 6);
+    K.row(0) = weakRow(s.model, i, sigma, rng).transpose();
+    s.local.push_back(std::make_shared<LocalRows>("weak@" + std::to_string(i), i, K));
+    ++added;
+  }
+}
+
 inline double relErr(const VecX& a, const VecX& b) {
   return (a - b).norm() / std::max(1.0, b.norm());
 }
