@@ -5,6 +5,8 @@
 
 #include "tree_solver_workspace.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -71,19 +73,25 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   ws.vdot = VecX::Zero(model.nv);
   ws.lambda = VecX::Zero(ws.m);
   ws.fsub.assign(model.nbodies, Vec6::Zero());
+  ws.floop.assign(model.nbodies, Vec6::Zero());
   ws.a0.assign(model.nbodies, Vec6::Zero());
-  ws.vdot_acc = VecX::Zero(model.nv);
-  ws.lambda_acc = VecX::Zero(ws.m);
-  ws.resid_f = VecX::Zero(model.nv);
   const int k = static_cast<int>(ws.loops.size());
   if (k > 0) {
     ws.W = MatX::Zero(model.nv, k);
     ws.L = MatX::Zero(ws.m, k);
-    ws.schur = MatX::Zero(k, k);
-    ws.schur_svd = Eigen::JacobiSVD<MatX>(k, k, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    ws.Z = MatX::Zero(6 * model.nbodies, k);
+    ws.z_svd = decltype(ws.z_svd)(6 * model.nbodies, k, Eigen::ComputeThinV);
+    // R_i = Λ^½ Vᵀ from I_i = V Λ Vᵀ: also for a body whose inertia is only
+    // semidefinite (a massless frame, a point mass).
+    ws.inertia_root.resize(model.nbodies);
+    for (int i = 0; i < model.nbodies; ++i) {
+      const Eigen::SelfAdjointEigenSolver<Mat6> es(model.spatial_inertia[i]);
+      ws.inertia_root[i] = es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() *
+                           es.eigenvectors().transpose();
+    }
     ws.vdot0 = VecX::Zero(model.nv);
     ws.lambda0 = VecX::Zero(ws.m);
-    for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp})
+    for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp, &ws.loop_unit, &ws.loop_share, &ws.loop_fnorm})
       *x = VecX::Zero(k);
   }
 }
@@ -153,8 +161,6 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     return;
   }
   ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;
-  for (int s = ws.loop_refinement; s > 0; --s)
-    detail::refine(model, data, cdata, ws, q, v, tau, false);
   out.vdot = ws.vdot;
   out.lambda = ws.lambda;
   detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
@@ -195,8 +201,6 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     ws.last_error = detail::describeFailure(model, data, ws);
     return false;
   }
-  for (int s = ws.loop_refinement; s > 0; --s)
-    detail::refine(model, data, cdata, ws, q, v, ws.tau, true);
   v += ws.vdot;
   impulse = -ws.lambda;  // the shared convention: v⁺ = v − M⁻¹Aᵀμ
   return true;

@@ -227,21 +227,20 @@ struct TreeWorkspace {
   VecX vdot, lambda;
   int redundant = 0;
   Failure failure;
-  /// Refinement steps the loop closure asks for: its Schur complement squares
-  /// the conditioning of the loop rows (tree_solver_refine.cpp).
-  int loop_refinement = 0;
-  VecX vdot_acc, lambda_acc, resid_f;
   /// Compliance factors (tree_solver_soft.cpp): F' of a joint, F_d, F_k of a stack.
   Eigen::JacobiSVD<StackMat, Eigen::ColPivHouseholderQRPreconditioner> svd12;
 
-  // Loop closure: k unit solves and the Schur complement.
+  // Loop closure: k unit solves and the square root of the Schur complement.
   MatX W;                                 ///< nv × k, response to each loop row's force
   MatX L;                                 ///< m × k, tree multipliers of each response
-  MatX schur;                             ///< k × k
-  Eigen::JacobiSVD<MatX> schur_svd;
-  VecX vdot0, lambda0, loop_target, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp;
+  MatX Z;                                 ///< 6n × k, [R_i a_i] per response: S = Zᵀ Z
+  std::vector<Mat6> inertia_root;         ///< R_i with I_i = R_iᵀ R_i (body frame, constant)
+  Eigen::JacobiSVD<MatX, Eigen::ColPivHouseholderQRPreconditioner> z_svd;
+  VecX vdot0, lambda0, loop_target, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp, loop_unit;
+  VecX loop_share, loop_fnorm;             ///< free share and norm of each loop row's force
   std::vector<Vec6> a0;                   ///< body accelerations of the main pass
   std::vector<Vec6> fsub;                 ///< subtree constraint forces (world frame)
+  std::vector<Vec6> floop;                ///< subtree loop-row force (body frame, freeShare)
   int loop_rank = 0;
 
   std::string last_error;
@@ -289,10 +288,6 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
 /// `impulse`, the velocity projection.
 void loopTargets(const Model& model, const Data& data, const ConstraintData& cdata,
                  TreeWorkspace& ws, const VecX& v, bool impulse);
-/// One step of iterative refinement on the KKT residual, reusing the
-/// factorization (tree_solver_refine.cpp). `impulse`: the projection problem.
-void refine(const Model& model, Data& data, const ConstraintData& cdata, TreeWorkspace& ws,
-            const VecX& q, const VecX& v, const VecX& tau, bool impulse);
 
 // Compliant rows (tree_solver_soft.cpp).
 /// After compress(): the stack's compliance factor carried through Q, the

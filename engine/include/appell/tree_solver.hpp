@@ -15,8 +15,9 @@
 // unrolled through the compressions with their adjoints.
 //
 // Rows between two moving bodies and joint-space rows close loops: they are
-// auxiliary unknowns, found from a small rank-revealing (SVD) Schur complement
-// after one extra tree solve per row (O(k n)).
+// auxiliary unknowns, found from a small rank-revealing Schur complement after
+// one extra tree solve per row (O(k n)), factored in square-root form (the
+// SVD of its kinetic-energy root, never the complement itself).
 //
 // Exact: no iterations, no regularisation. No heap allocation inside solve()
 // or projectVelocity() once `out` has the right sizes (all workspace is sized
