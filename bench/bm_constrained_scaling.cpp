@@ -6,10 +6,12 @@
 // every iteration and reports the ratio of their summed times: both see the
 // same machine state (clock, neighbours, caches), so the ratio stays stable
 // when the absolute times of separate runs drift.
+// BM_TreeLoops: the cost of k loop-closing rows over the same tree solve.
 // The dense solvers stop at 256 bodies (O(n³); the comparison point is 256).
 // Each iteration evaluates nothing: the rows are evaluated once at a state
 // whose velocity satisfies them, and the solve alone is timed.
 #include <appell/appell_maggi.hpp>
+#include <appell/custom_constraint.hpp>
 #include <appell/kkt.hpp>
 #include <appell/tree_solver.hpp>
 
@@ -106,6 +108,72 @@ void BM_Kkt(benchmark::State& st) { run(st, Which::Kkt); }
 void BM_Appell(benchmark::State& st) { run(st, Which::Appell); }
 void BM_TreeOverAba(benchmark::State& st) { run(st, Which::TreeOverAba); }
 
+/// Loop rows: the fleet (N bodies) with the left wheels of robots 0 … k
+/// geared together (joint-space rows q̇_L(r) − q̇_L(r+1) = 0, an electronic
+/// line shaft) — k rows that close loops through the world, solved by k unit
+/// replays and the square root of their Schur complement (O(k n)). Each
+/// iteration interleaves a solve with these rows and one of the same fleet
+/// without them; the counter is the ratio of their summed times.
+void BM_TreeLoops(benchmark::State& st) {
+  const int k = static_cast<int>(st.range(1));
+  auto s = scenes::fleet(std::max(k + 1, static_cast<int>(st.range(0)) / 3));
+  std::vector<int> left;
+  for (int i = 0; i < s.model.nbodies; ++i)
+    if (s.model.body_names[i].back() == 'L') left.push_back(s.model.joints[i].idx_v);
+  ConstraintList loops = s.constraints;
+  for (int r0 = 0; r0 < k; r0 += 6) {  // custom constraints hold at most 6 rows
+    const int m = std::min(6, k - r0);
+    CustomRows spec;
+    spec.name = "line_shaft" + std::to_string(r0 / 6);
+    spec.rows = m;
+    spec.A_b = [left, r0, m](const Model&, const VecX&, double, Eigen::Ref<MatX> A,
+                             Eigen::Ref<VecX> b) {
+      A.setZero();
+      b.setZero();
+      for (int r = 0; r < m; ++r) A(r, left[r0 + r]) = 1, A(r, left[r0 + r + 1]) = -1;
+    };
+    spec.bias = [](const Model&, const VecX&, const VecX&, double, Eigen::Ref<VecX> ab) {
+      ab.setZero();
+    };
+    loops.push_back(std::make_shared<CustomConstraint>(spec));
+  }
+
+  Data data(s.model);
+  ConstraintData cd(s.model, s.constraints), cdl(s.model, loops);
+  TreeSolver plain(s.model, s.constraints), closed(s.model, loops);
+  evaluateConstraints(s.model, data, loops, cdl, 0.0, s.q, s.v);
+  VecX v = s.v, mu;
+  if (!closed.projectVelocity(s.model, data, loops, cdl, s.q, v, mu)) {
+    st.SkipWithError(closed.lastError().c_str());
+    return;
+  }
+  evaluateConstraints(s.model, data, s.constraints, cd, 0.0, s.q, v);
+  evaluateConstraints(s.model, data, loops, cdl, 0.0, s.q, v);
+  const VecX tau = VecX::Constant(s.model.nv, 0.1);
+  ConstrainedResult out;
+  closed.solve(s.model, data, loops, cdl, s.q, v, tau, out);
+  if (!out.ok) {
+    st.SkipWithError(out.error.c_str());
+    return;
+  }
+  using Clock = std::chrono::steady_clock;
+  double loop_s = 0, plain_s = 0;
+  for (auto _ : st) {
+    const auto t0 = Clock::now();
+    closed.solve(s.model, data, loops, cdl, s.q, v, tau, out);
+    benchmark::DoNotOptimize(out.vdot.data());
+    const auto t1 = Clock::now();
+    plain.solve(s.model, data, s.constraints, cd, s.q, v, tau, out);
+    benchmark::DoNotOptimize(out.vdot.data());
+    const auto t2 = Clock::now();
+    loop_s += std::chrono::duration<double>(t1 - t0).count();
+    plain_s += std::chrono::duration<double>(t2 - t1).count();
+  }
+  st.counters["loops_over_tree"] = loop_s / plain_s;
+  st.counters["bodies"] = s.model.nbodies;
+  st.counters["loop_rows"] = k;
+}
+
 }  // namespace
 
 // scene: 0 N-trailer, 1 wheeled snake, 2 fleet, 3 car row.
@@ -114,3 +182,7 @@ BENCHMARK(BM_Aba)->Apply([](auto* b) { sizes(b, 1024); });
 BENCHMARK(BM_Kkt)->Apply([](auto* b) { sizes(b, 256); });
 BENCHMARK(BM_Appell)->Apply([](auto* b) { sizes(b, 256); });
 BENCHMARK(BM_TreeOverAba)->Apply([](auto* b) { sizes(b, 1024); });
+BENCHMARK(BM_TreeLoops)
+    ->ArgsProduct({{64, 256, 1024}, {1, 4, 16}})
+    ->ArgNames({"N", "k"})
+    ->Unit(benchmark::kMicrosecond);
