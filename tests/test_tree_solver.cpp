@@ -214,13 +214,7 @@ TEST(TreeSolver, SingularPoseOfAStretchedArm) {
 
   // Same pose, an inconsistent right side on the immobile row.
   s.local[0]->kappa()[0] += 0.5;
-  const ConstraintList list = s.list();
-  Data data(s.model);
-  ConstraintData cd(s.model, list);
-  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-  TreeSolver solver(s.model, list);
-  ConstrainedResult out;
-  solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+  const ConstrainedResult out = treeSolve(s);
   EXPECT_FALSE(out.ok);
   EXPECT_NE(out.error.find("'tip'"), std::string::npos) << out.error;
 }
@@ -246,13 +240,7 @@ TEST(TreeSolver, InconsistentDuplicateIsAnErrorNamingTheConstraints) {
     EXPECT_EQ(c.rank, 3);
     // Now break the duplicate's right side.
     s.local[1]->kappa()[0] += 1e-3;
-    const ConstraintList list = s.list();
-    Data data(s.model);
-    ConstraintData cd(s.model, list);
-    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-    TreeSolver solver(s.model, list);
-    ConstrainedResult out;
-    solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+    const ConstrainedResult out = treeSolve(s);
     EXPECT_FALSE(out.ok);
     EXPECT_NE(out.error.find("'first'"), std::string::npos) << out.error;
     EXPECT_NE(out.error.find("'second'"), std::string::npos) << out.error;
@@ -287,12 +275,7 @@ TEST(TreeSolver, InconsistentRowsSpreadOverATree) {
   makeConsistent(s, rng);
   EXPECT_LT(compare(s).vdot, 1e-11);
   s.local[0]->kappa()[0] += 0.1;
-  const ConstraintList list = s.list();
-  ConstraintData cd(s.model, list);
-  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-  TreeSolver solver(s.model, list);
-  ConstrainedResult out;
-  solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+  const ConstrainedResult out = treeSolve(s);
   EXPECT_FALSE(out.ok);
   EXPECT_NE(out.error.find("'on_tool'"), std::string::npos) << out.error;
   EXPECT_NE(out.error.find("'on_plate'"), std::string::npos) << out.error;
@@ -428,13 +411,7 @@ TEST(TreeSolver, RedundantLoopRowCopiesATreeRow) {
 TEST(TreeSolver, InconsistentLoopRowsAreAnErrorNamingThem) {
   std::mt19937 rng(24);
   auto solveOk = [](const System& s, std::string& error) {
-    const ConstraintList list = s.list();
-    Data data(s.model);
-    ConstraintData cd(s.model, list);
-    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-    TreeSolver solver(s.model, list);
-    ConstrainedResult out;
-    solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+    const ConstrainedResult out = treeSolve(s);
     error = out.error;
     return out.ok;
   };

@@ -122,6 +122,18 @@ inline void makeConsistent(System& s, std::mt19937& rng) {
   }
 }
 
+/// One tree solve of s at its state, with a solver built for it.
+inline ConstrainedResult treeSolve(const System& s) {
+  const ConstraintList list = s.list();
+  Data data(s.model);
+  ConstraintData cd(s.model, list);
+  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  TreeSolver solver(s.model, list);
+  ConstrainedResult out;
+  solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out);
+  return out;
+}
+
 /// Pseudo-inverse solve with a relative singular-value threshold.
 inline VecX pinvSolve(const MatX& A, const VecX& b, double rel = 1e-10) {
   Eigen::JacobiSVD<MatX> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
