@@ -395,11 +395,7 @@ TEST(TreeSolver, RedundantLoopRowCopiesATreeRow) {
   K.row(0) = randomRow(rng).transpose();
   K.row(1) = randomRow(rng).transpose();
   s.local.push_back(std::make_shared<LocalRows>("tree_rows", 6, K));
-  const ConstraintList l0 = s.list();
-  Data data(s.model);
-  ConstraintData cd0(s.model, l0);
-  evaluateConstraints(s.model, data, l0, cd0, 0.0, s.q, s.v);
-  s.joint.push_back(std::make_shared<JointRows>("copy", 3.0 * cd0.A.bottomRows(1)));
+  addJointCopyOfLastRow(s, "copy", 3.0);
   makeConsistent(s, rng);
   const Compared c = compare(s);
   EXPECT_LT(c.vdot, 1e-10);
@@ -423,11 +419,7 @@ TEST(TreeSolver, InconsistentLoopRowsAreAnErrorNamingThem) {
     Rows K(1, 6);
     K.row(0) = randomRow(rng).transpose();
     s.local.push_back(std::make_shared<LocalRows>("tree_row", 6, K));
-    const ConstraintList l0 = s.list();
-    Data data(s.model);
-    ConstraintData cd0(s.model, l0);
-    evaluateConstraints(s.model, data, l0, cd0, 0.0, s.q, s.v);
-    s.joint.push_back(std::make_shared<JointRows>("copy", -2.0 * cd0.A.bottomRows(1)));
+    addJointCopyOfLastRow(s, "copy", -2.0);
     makeConsistent(s, rng);
     EXPECT_TRUE(solveOk(s, error)) << error;
     s.joint[0]->abias()[0] += 1e-3;

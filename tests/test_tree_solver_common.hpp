@@ -134,6 +134,17 @@ inline ConstrainedResult treeSolve(const System& s) {
   return out;
 }
 
+/// A joint-space constraint `name` whose one row is `scale` × the last row
+/// of A at s's state: redundant with the tree rows (a loop row they make
+/// immobile).
+inline void addJointCopyOfLastRow(System& s, const std::string& name, double scale) {
+  const ConstraintList list = s.list();
+  Data data(s.model);
+  ConstraintData cd(s.model, list);
+  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  s.joint.push_back(std::make_shared<JointRows>(name, scale * cd.A.bottomRows(1)));
+}
+
 /// Pseudo-inverse solve with a relative singular-value threshold.
 inline VecX pinvSolve(const MatX& A, const VecX& b, double rel = 1e-10) {
   Eigen::JacobiSVD<MatX> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
