@@ -91,7 +91,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
     }
     ws.vdot0 = VecX::Zero(model.nv);
     ws.lambda0 = VecX::Zero(ws.m);
-    for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp, &ws.loop_unit, &ws.loop_share, &ws.loop_fnorm})
+    for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp, &ws.loop_resid, &ws.loop_share, &ws.loop_fnorm})
       *x = VecX::Zero(k);
   }
 }

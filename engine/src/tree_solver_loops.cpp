@@ -161,18 +161,16 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
   while (rank < k && s(rank) > thr) ++rank;
   ws.loop_rank = rank;
   ws.loop_tmp.noalias() = V.transpose() * ws.loop_res;
-  for (int l = 0; l < k; ++l) ws.loop_tmp[l] = l < rank ? ws.loop_tmp[l] / (s(l) * s(l)) : 0.0;
-  ws.loop_lambda.noalias() = V * ws.loop_tmp;
+  ws.loop_tmp.head(rank).array() /= s.head(rank).array().square();
+  ws.loop_lambda.noalias() = V.leftCols(rank) * ws.loop_tmp.head(rank);
 
   // Consistency: V₂ V₂ᵀ r must vanish.
-  ws.loop_tmp.noalias() = V.transpose() * ws.loop_res;
-  ws.loop_tmp.head(rank).setZero();
-  ws.loop_unit.noalias() = V * ws.loop_tmp;
-  const double res = ws.loop_unit.lpNorm<Eigen::Infinity>();
+  ws.loop_resid.noalias() = V.rightCols(k - rank) * ws.loop_tmp.tail(k - rank);
+  const double res = ws.loop_resid.lpNorm<Eigen::Infinity>();
   if (res > o.consistency_tol * std::max(1.0, ws.loop_res.lpNorm<Eigen::Infinity>())) {
     std::string names;
     for (int l = 0; l < k; ++l) {
-      if (std::abs(ws.loop_unit[l]) <= 0.01 * res) continue;
+      if (std::abs(ws.loop_resid[l]) <= 0.01 * res) continue;
       const std::string& n = ws.names[ws.loops[l].constraint];
       if (names.find("'" + n + "'") != std::string::npos) continue;
       if (!names.empty()) names += ", ";

@@ -236,7 +236,7 @@ struct TreeWorkspace {
   MatX Z;                                 ///< 6n × k, [R_i a_i] per response: S = Zᵀ Z
   std::vector<Mat6> inertia_root;         ///< R_i with I_i = R_iᵀ R_i (body frame, constant)
   Eigen::JacobiSVD<MatX, Eigen::ColPivHouseholderQRPreconditioner> z_svd;
-  VecX vdot0, lambda0, loop_target, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp, loop_unit;
+  VecX vdot0, lambda0, loop_target, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp, loop_resid;
   VecX loop_share, loop_fnorm;             ///< free share and norm of each loop row's force
   std::vector<Vec6> a0;                   ///< body accelerations of the main pass
   std::vector<Vec6> fsub;                 ///< subtree constraint forces (world frame)
