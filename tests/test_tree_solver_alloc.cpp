@@ -51,7 +51,7 @@ TEST(TreeSolverAllocations, NoneOnRandomTrees) {
 }
 
 TEST(TreeSolverAllocations, NoneWithRowsHandedUpWithCompliance) {
-  // Rows the bodies' own joints barely move (tree_solver_soft.cpp), some on a
+  // Rows the bodies' own joints barely move (tree_solver/soft.cpp), some on a
   // free body that already has six rows (compliant dropped combinations).
   std::mt19937 rng(33);
   for (bool floating : {false, true}) {

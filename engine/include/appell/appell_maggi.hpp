@@ -24,7 +24,7 @@
 //     1/σ_min(A_d) of the equilibrated rows stays below partition_cond_max and
 //     re-chosen otherwise (or when the rank changes); every re-choice is
 //     counted and described (partitionChanges(), partitionMessage()).
-// Rank-deficient A: the same rank decision as the KKT solver (kkt_rows).
+// Rank-deficient A: the same rank decision as the KKT solver (solvers/row_basis.hpp).
 #pragma once
 
 #include <appell/constrained_dynamics.hpp>

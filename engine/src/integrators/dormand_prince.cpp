@@ -1,0 +1,112 @@
+// Dormand–Prince 5(4) (Dormand & Prince, J. Comput. Appl. Math. 6 (1980) 19–26)
+// with the RKMK construction of rk4.cpp, FSAL reuse of the last acceleration,
+// and the standard step controller h⁺ = h·min(5, max(0.2, 0.9·err^(−1/5)))
+// (Hairer, Nørsett, Wanner, Solving ODEs I, §II.4).
+#include "integrators/integrators_impl.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace appell::detail {
+
+namespace {
+
+constexpr double C[7] = {0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1, 1};
+constexpr double A[7][6] = {
+    {},
+    {1.0 / 5},
+    {3.0 / 40, 9.0 / 40},
+    {44.0 / 45, -56.0 / 15, 32.0 / 9},
+    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+    {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
+// Difference between the 5th-order weights (row 7 of A) and the embedded 4th-order ones.
+constexpr double E[7] = {71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200,
+                         22.0 / 525, -1.0 / 40};
+
+}  // namespace
+
+DormandPrince54::DormandPrince54(const Model& model, const IntegratorOptions& options)
+    : model_(model), opt_(options), theta_(model.nv), vs_(model.nv), qs_(model.nq),
+      err_th_(model.nv), err_v_(model.nv), scale_q_(model.nv) {
+  for (auto& k : kth_) k.resize(model.nv);
+  for (auto& k : kv_) k.resize(model.nv);
+}
+
+StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) {
+  StepResult r;
+  h = std::min(h, opt_.h_max);
+  // Magnitudes the local coordinates are measured against: the coordinate itself
+  // for Euclidean joints, 1 rad for rotations.
+  for (const Joint& j : model_.joints) {
+    const bool rot = j.type == JointType::Floating || j.type == JointType::Ball;
+    for (int k = 0; k < j.nv; ++k) {
+      const bool euclid = !rot || (j.type == JointType::Floating && k >= 3);
+      scale_q_[j.idx_v + k] = euclid ? std::abs(q[j.idx_q + k - (j.type == JointType::Floating ? 3 : 0)]) : 1.0;
+    }
+  }
+  theta_.setZero();
+  localRate(model_, q, theta_, v, kth_[0]);
+  if (!have_fsal_) {
+    ++r.evaluations;
+    if (!f(t, q, v, kv_[0]) || !kv_[0].allFinite()) {
+      r.ok = false;
+      return r;
+    }
+  }
+  for (;;) {
+    bool field_ok = true;
+    for (int s = 1; s < 7 && field_ok; ++s) {
+      theta_.setZero();
+      vs_ = v;
+      for (int k = 0; k < s; ++k) {
+        if (A[s][k] == 0) continue;
+        theta_ += (h * A[s][k]) * kth_[k];
+        vs_ += (h * A[s][k]) * kv_[k];
+      }
+      retract(model_, q, theta_, qs_);
+      localRate(model_, q, theta_, vs_, kth_[s]);
+      ++r.evaluations;
+      field_ok = f(t + C[s] * h, qs_, vs_, kv_[s]) && kv_[s].allFinite() && qs_.allFinite();
+    }
+    double err = std::numeric_limits<double>::infinity();
+    if (field_ok) {
+      // Stage 7 sits at the 5th-order solution (θ, v) = (theta_, vs_), q = qs_.
+      err_th_.setZero();
+      err_v_.setZero();
+      for (int k = 0; k < 7; ++k) {
+        err_th_ += (h * E[k]) * kth_[k];
+        err_v_ += (h * E[k]) * kv_[k];
+      }
+      double sum = 0;
+      for (int i = 0; i < model_.nv; ++i) {
+        const double sq = opt_.atol + opt_.rtol * std::max(scale_q_[i], scale_q_[i] + std::abs(theta_[i]));
+        const double sv = opt_.atol + opt_.rtol * std::max(std::abs(v[i]), std::abs(vs_[i]));
+        sum += std::pow(err_th_[i] / sq, 2) + std::pow(err_v_[i] / sv, 2);
+      }
+      err = model_.nv > 0 ? std::sqrt(sum / (2.0 * model_.nv)) : 0.0;
+    }
+    if (field_ok && err <= 1.0) {
+      q = qs_;
+      v = vs_;
+      t += h;
+      kv_[0] = kv_[6];  // FSAL: the last stage is the next step's first
+      have_fsal_ = true;
+      r.h_taken = h;
+      r.error = err;
+      const double grow = err > 0 ? opt_.safety * std::pow(err, -0.2) : 5.0;
+      r.h_next = std::min(opt_.h_max, h * std::clamp(grow, 0.2, 5.0));
+      return r;
+    }
+    ++r.rejected;
+    h *= field_ok ? std::clamp(opt_.safety * std::pow(err, -0.2), 0.1, 0.9) : 0.25;
+    if (h < opt_.h_min) {
+      r.ok = false;
+      r.h_next = h;
+      have_fsal_ = false;
+      return r;
+    }
+  }
+}
+
+}  // namespace appell::detail

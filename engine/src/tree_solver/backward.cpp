@@ -1,0 +1,443 @@
+// Tree solver, backward passes (leaves → root). See docs/tree-solver.md.
+//
+// factorPass: everything that depends on the pose and the rows but not on the
+// right sides — row compression, the split of each joint by K S (a norm and a
+// reflector for one DoF, the compression's triangular factor for a free
+// joint, an SVD otherwise), and the articulated inertias with the
+// particular/free coupling kept.
+// biasPass: the right sides — articulated bias forces and the right sides of
+// the compressed and handed-up rows; it can be replayed cheaply for the unit
+// solves of the loop closure and for the impulse solve.
+#include "tree_solver/workspace.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace appell::detail {
+
+namespace {
+
+/// Writes `rows` (r × 6) into rows at..at+r of the QR's stack.
+void stackRows(PivotedQR& qr, int at, const KRows& rows) {
+  for (int r = 0; r < rows.rows(); ++r) Eigen::Map<Vec6>(qr.a[at + r]) = rows.row(r).transpose();
+}
+
+/// Rank-revealing compression of the `nb` rows stacked in cp.f:
+/// equilibrate each row (rows already below the absolute tolerance are left
+/// alone, so round-off residue of a redundant row is never blown up into a
+/// fake constraint), then Householder QR with column pivoting, Qᵀ E B Π = R,
+/// stopped at the numerical rank (pivoted_qr.hpp). Sets out = Q₁ᵀ E B = R₁ Πᵀ
+/// — read off R, no product with Q.
+void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out) {
+  PivotedQR& qr = cp.f;
+  cp.nrows = nb;
+  cp.E.resize(nb);
+  for (int r = 0; r < nb; ++r) {
+    Eigen::Map<Vec6> row(qr.a[r]);
+    const double n = row.norm();
+    const double e = n > o.rank_abs_tol ? 1.0 / n : 1.0;
+    cp.E[r] = e;
+    row *= e;
+  }
+  qr.factor(nb, o.rank_abs_tol, o.rank_rel_tol);
+  const int rank = qr.rank;
+  cp.rank = rank;
+  out.setZero(rank, 6);
+  for (int c = 0; c < 6; ++c)
+    for (int r = 0; r <= std::min(c, rank - 1); ++r) out(r, qr.perm[c]) = qr(r, c);
+}
+
+/// A child's handed-up rows (its frame) mapped to this body's frame by the
+/// force transform and stacked at row `at` of the QR.
+void stackChildRows(const SE3& liMi, const KRows& rows, PivotedQR& qr, int at) {
+  for (int r = 0; r < rows.rows(); ++r) {
+    Eigen::Map<Vec6>(qr.a[at + r]) = liMi.actForce(rows.row(r).transpose());
+  }
+}
+
+/// Body rows of a constraint block, world covectors → body frame (adjoint of
+/// the motion transform: w_body = ᵒX_iᵀ w), stacked at row `at` of the QR.
+void stackBodyRows(const Data& data, const ConstraintData& cdata, const TreeBlock& tb,
+                   PivotedQR& qr, int at) {
+  const RowBlock& blk = cdata.blocks[tb.constraint];
+  const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
+  const SE3& oMi = data.oMi[tb.body];
+  for (int r = 0; r < tb.rows; ++r) {
+    Eigen::Map<Vec6>(qr.a[at + r]) = oMi.actInvForce(tb.sign * W.row(r).transpose());
+  }
+}
+
+/// out += Xᵀ H X with X = ᵖXᵢ (motion, parent → child) of M = liMi, i.e.
+/// out += F H Fᵀ with the force transform F = [R, p̂R; 0, R] — done blockwise
+/// (rotate the 3×3 blocks, then shear by p̂), with no 6×6 transform built.
+/// H is symmetric (Pᵀ Ia P), so its lower-left block is never read and the
+/// result's lower-left block is the transpose of its upper-right one.
+void addCongruence(const SE3& M, const Mat6& H, Mat6& out) {
+  const Mat3& R = M.R;
+  const Mat3 A = R * H.topLeftCorner<3, 3>() * R.transpose();
+  const Mat3 B = R * H.topRightCorner<3, 3>() * R.transpose();
+  const Mat3 D = R * H.bottomRightCorner<3, 3>() * R.transpose();
+  const Mat3 ph = skew(M.p);
+  const Mat3 Bt = B + ph * D;  // top-right of T H' Tᵀ, T = [1, p̂; 0, 1]
+  out.topRightCorner<3, 3>() += Bt;
+  out.bottomLeftCorner<3, 3>() += Bt.transpose();
+  out.bottomRightCorner<3, 3>() += D;
+  out.topLeftCorner<3, 3>().noalias() += A + ph * B.transpose() - Bt * ph;
+}
+
+/// Split of a free joint (S = 1, so G = K) without an SVD. The last
+/// compression left K = [R₁₁ R₁₂] Πᵀ with R₁₁ upper triangular and
+/// nonsingular (its pivots passed the rank test), so
+///   G⁺ = Π [R₁₁⁻¹; 0]  (a right inverse: K G⁺ = 1),
+///   V₂ = Π [−R₁₁⁻¹ R₁₂; 1]  (a basis of null K),
+/// and no row is handed up. Neither need be orthogonal: the free part is
+/// minimised over all of null K, so v̇ is the constrained minimiser, and
+/// μ = G⁺ᵀ(Sᵀf − τ) is exact because the force balance along V₂ puts Sᵀf − τ
+/// in the range of Gᵀ. σ_min(K) ≥ σ_min(R₁₁) ≥ 1/‖R₁₁⁻¹‖_F: when that bound is
+/// above kWeakPivot the SVD would resolve every row too; otherwise returns
+/// false and the caller takes the SVD.
+bool freeSplit(Node& nd) {
+  const int n = nd.nK;
+  const int* perm = nd.comp[nd.ncomp - 1].f.perm;
+  double R[6][6], Ri[6][6] = {};
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < 6; ++c) R[r][c] = nd.K(r, perm[c]);
+  double fro = 0;
+  for (int c = 0; c < n; ++c)  // back substitution, R₁₁ X = 1, column by column
+    for (int r = c; r >= 0; --r) {
+      double x = r == c ? 1.0 : 0.0;
+      for (int k = r + 1; k <= c; ++k) x -= R[r][k] * Ri[k][c];
+      Ri[r][c] = x / R[r][r];
+      fro += Ri[r][c] * Ri[r][c];
+    }
+  const double lb = 1.0 / std::sqrt(fro);
+  if (!(lb > kWeakPivot)) return false;
+  nd.Gpinv.setZero(6, n);
+  nd.V2.setZero(6, 6 - n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) nd.Gpinv(perm[r], c) = Ri[r][c];
+    for (int f = 0; f < 6 - n; ++f) {
+      double x = 0;
+      for (int k = r; k < n; ++k) x -= Ri[r][k] * R[k][n + f];
+      nd.V2(perm[r], f) = x;
+    }
+  }
+  for (int f = 0; f < 6 - n; ++f) nd.V2(perm[n + f], f) = 1;
+  nd.u2form = U2Form::Identity;
+  nd.npass = 0;
+  return true;
+}
+
+/// One-DoF joint (revolute, prismatic, continuous: most bodies). The SVD of
+/// the column g = K s is its norm σ and a Householder reflector H = 1 − β u uᵀ
+/// with H g = ∓σ e₁, whose other columns span U₂ — kept as (u, β), never
+/// formed. With the row resolved (ρ = 1) nothing is free and
+///   H = Pᵀ IA P = IA − (gk zᵀ + z gkᵀ),  P = 1 − s gkᵀ, gk = Kᵀ g / σ²,
+///   z = IA s − ½ (sᵀ IA s) gk,
+/// a symmetric rank-2 update; otherwise it is ABA's 1-DoF elimination.
+/// Returns false, leaving the split to splitSoft, when 0 < σ < kWeakPivot.
+bool splitOneDof(const SolverOptions& o, const Joint& j, bool root, Node& nd, Mat6& H) {
+  // Rows of K (row-major, nK × 6) as fixed-size 6-vectors: the products below
+  // are a handful of 6-wide dots and axpys, not Eigen's dynamic-size kernels.
+  const int nK = nd.nK;
+  auto row = [&](int r) { return Eigen::Map<const Vec6>(nd.K.data() + 6 * r); };
+  const Vec6 s = j.S.col(0);
+  double g[6], sigma2 = 0;
+  for (int r = 0; r < nK; ++r) {
+    g[r] = row(r).dot(s);
+    sigma2 += g[r] * g[r];
+  }
+  const double sigma = std::sqrt(sigma2);
+  if (sigma > o.rank_abs_tol && sigma < kWeakPivot) return false;  // compliant rows
+  if (sigma > o.rank_abs_tol) {
+    nd.rankG = 1;
+    nd.npass = nK - 1;
+    nd.nf = 0;
+    nd.gp.resize(nK);  // G⁺ᵀ = g/σ²; nothing free: V2, S2 unused
+    for (int r = 0; r < nK; ++r) nd.gp[r] = g[r] / sigma2;
+    if (nK > 1) {
+      nd.u2form = U2Form::Reflector;
+      nd.hu.resize(nK);
+      for (int r = 0; r < nK; ++r) nd.hu[r] = g[r] / sigma;
+      nd.hu[0] += nd.hu[0] >= 0 ? 1.0 : -1.0;
+      nd.hbeta = 2.0 / nd.hu.squaredNorm();
+      // Kpass = U₂ᵀ K = rows 1… of H K = K − β u (uᵀ K).
+      Vec6 uK = Vec6::Zero();
+      for (int r = 0; r < nK; ++r) uK += nd.hu[r] * row(r);
+      nd.Kpass.resize(nK - 1, 6);
+      for (int r = 1; r < nK; ++r)
+        Eigen::Map<Vec6>(nd.Kpass.data() + 6 * (r - 1)) = row(r) - (nd.hbeta * nd.hu[r]) * uK;
+    } else {
+      nd.u2form = U2Form::Identity;  // no rows left: U₂ is empty
+      nd.Kpass.resize(0, 6);
+    }
+    if (root) return true;  // H, gk and ias only serve the parent
+    Vec6& gk = nd.gk;
+    gk.setZero();
+    for (int r = 0; r < nK; ++r) gk += nd.gp[r] * row(r);
+    const Vec6& w = nd.ias = nd.IA * s;  // nothing free: Ia = IA
+    const Vec6 z = w - (0.5 * s.dot(w)) * gk;
+    H = nd.IA;
+    H.noalias() -= gk * z.transpose();
+    H.noalias() -= z * gk.transpose();
+  } else {
+    nd.rankG = 0;
+    nd.npass = nK;
+    nd.nf = 1;
+    nd.u2form = U2Form::Identity;
+    nd.Kpass = nd.K;
+    nd.V2.setIdentity(1, 1);
+    nd.S2 = j.S;
+    const Vec6 U = nd.IA * s;
+    const double Dinv = 1.0 / s.dot(U);
+    nd.U = U;
+    nd.Dinv.setConstant(1, 1, Dinv);
+    H = nd.IA;
+    H.noalias() -= (Dinv * U) * U.transpose();
+  }
+  return true;
+}
+
+/// Any other joint: a free joint's split from the compression's R₁₁ when well
+/// conditioned, otherwise the SVD of G = K S; then the free part eliminated
+/// as in ABA and H = Pᵀ Ia P. Returns false, leaving the split to splitSoft,
+/// when a kept singular value is below kWeakPivot.
+bool splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H) {
+  const SolverOptions& o = ws.options;
+  const int nv = j.nv, nK = nd.nK;
+  int rho = 0;
+  nd.u2form = U2Form::Explicit;
+  if (nK > 0 && j.type == JointType::Floating && freeSplit(nd)) {
+    rho = nK;
+  } else if (nK > 0 && nv > 0) {
+    const SmallMat G = nd.K * j.S;
+    ws.svd.compute(G, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const auto& sv = ws.svd.singularValues();
+    const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * sv(0));
+    while (rho < sv.size() && sv(rho) > thr) ++rho;
+    if (rho > 0 && sv(rho - 1) < kWeakPivot) return false;  // compliant rows
+    const auto& Um = ws.svd.matrixU();
+    const auto& Vm = ws.svd.matrixV();
+    if (rho > 0)
+      nd.Gpinv.noalias() = Vm.leftCols(rho) * sv.head(rho).cwiseInverse().asDiagonal() *
+                           Um.leftCols(rho).transpose();
+    nd.U2 = Um.rightCols(nK - rho);
+    nd.V2 = Vm.rightCols(nv - rho);
+  } else {
+    nd.u2form = U2Form::Identity;
+    nd.V2.setIdentity(nv, nv);
+  }
+  nd.rankG = rho;
+  nd.npass = nK - rho;
+  nd.nf = nv - rho;
+  if (nd.u2form == U2Form::Identity)
+    nd.Kpass = nd.K;
+  else if (nd.npass > 0)
+    nd.Kpass.noalias() = nd.U2.transpose() * nd.K;
+  else
+    nd.Kpass.resize(0, 6);
+
+  // GK = G⁺ K (nv × 6): P = 1 − S GK is a low-rank update of the identity,
+  // never formed when nv ≤ 2 (applied as x − GKᵀ(Sᵀx) / x − S(GK x)).
+  auto& GK = nd.GK;
+  if (rho > 0) {
+    if (!root) GK.noalias() = nd.Gpinv * nd.K;
+    nd.S2.noalias() = j.S * nd.V2;
+  } else {
+    nd.S2 = j.S;
+  }
+  if (nd.nf > 0) {
+    nd.U.noalias() = nd.IA * nd.S2;
+    const SmallMat D = nd.S2.transpose() * nd.U;
+    nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
+  }
+  if (root) return true;  // H, GK and IaS only serve the parent
+  Mat6 Ia = nd.IA;
+  if (nd.nf > 0) Ia.noalias() -= nd.U * nd.Dinv * nd.U.transpose();
+  if (rho > 0) {
+    // Pᵀ Ia P = Ia P − GKᵀ (Sᵀ Ia P), Ia P = Ia − (Ia S) GK: O(36 nv) per
+    // factor instead of two dense 6 × 6 products.
+    nd.IaS.noalias() = Ia * j.S;
+    Mat6 IaP = Ia;
+    IaP.noalias() -= nd.IaS * GK;
+    Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> SIaP(nv, 6);
+    SIaP.noalias() = j.S.transpose() * IaP;
+    H = IaP;
+    H.noalias() -= GK.transpose() * SIaP;
+  } else {
+    H = Ia;
+  }
+  return true;
+}
+
+}  // namespace
+
+void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
+                TreeWorkspace& ws) {
+  const SolverOptions& o = ws.options;
+  for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].IA = model.spatial_inertia[i];
+  ws.redundant = 0;
+
+  for (int i = model.nbodies - 1; i >= 0; --i) {
+    Node& nd = ws.nodes[i];
+    const Joint& j = model.joints[i];
+    const int p = model.parent[i];
+
+    // 1. Stack own rows and the children's unresolved rows, compressing
+    //    whenever the stack would exceed 12 rows and once at the end.
+    nd.ncomp = 0;
+    nd.nK = 0;
+    nd.K.resize(0, 6);
+    int nb = 0;
+    Compression* cur = &nd.comp[0];
+    cur->nseg = 0;
+    auto compressStack = [&]() {
+      compress(o, *cur, nb, nd.K);
+      nd.nK = cur->rank;
+      bool soft = false;
+      for (int s = 0; s < cur->nseg; ++s) soft |= softSegment(ws, nd, nd.ncomp, cur->seg[s]);
+      cur->soft = false;
+      ws.redundant += soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
+      cur = &nd.comp[++nd.ncomp];
+      cur->nseg = 0;
+    };
+    for (const Segment& g : nd.groups) {
+      const int r = g.kind == Segment::Block ? ws.blocks[g.id].rows : ws.nodes[g.id].npass;
+      if (r == 0) continue;
+      if (nb + r > 12) {  // compress, and carry the kept rows on
+        compressStack();
+        nb = nd.nK;
+        if (nb > 0) {
+          stackRows(cur->f, 0, nd.K);
+          cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
+        }
+      }
+      if (g.kind == Segment::Block)
+        stackBodyRows(data, cdata, ws.blocks[g.id], cur->f, nb);
+      else
+        stackChildRows(data.liMi[g.id], ws.nodes[g.id].Kpass, cur->f, nb);
+      cur->seg[cur->nseg++] = {g.kind, g.id, r};
+      nb += r;
+    }
+    if (cur->nseg > 0) compressStack();
+
+    // 2. Split the joint: G = K S = U Σ Vᵀ; rows along U₁ fix V₁ᵀ q̈, rows
+    //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.
+    // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
+    //    part z is eliminated as in ABA, and the parent sees H = Pᵀ Ia P — the
+    //    particular/free coupling the constrained-LQR equations drop.
+    Mat6 H;
+    nd.soft = false;
+    nd.softpass = false;
+    const bool soft_rows = nd.ncomp > 0 && nd.comp[nd.ncomp - 1].soft;
+    if (soft_rows || !(j.nv == 1 ? splitOneDof(o, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))
+      splitSoft(ws, j, p < 0, nd, H);
+    if (p < 0) ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
+    if (nd.npass > 0) nd.kpc.noalias() = nd.Kpass * nd.c;  // for the bias pass
+    if (p >= 0) {
+      nd.Hc.noalias() = H * nd.c;  // the velocity-product term of the bias pass
+      addCongruence(data.liMi[i], H, ws.nodes[p].IA);
+    }
+  }
+}
+
+bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check) {
+  const SolverOptions& o = ws.options;
+  for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].pA = ws.nodes[i].bias0;
+  ws.failure = {};
+
+  for (int i = model.nbodies - 1; i >= 0; --i) {
+    Node& nd = ws.nodes[i];
+    const Joint& j = model.joints[i];
+    const int p = model.parent[i];
+
+    // Right sides through the recorded compressions: Qᵀ E r.
+    for (int e = 0; e < nd.ncomp; ++e) {
+      Compression& cp = nd.comp[e];
+      BufVec r;
+      gatherRhs(ws, i, e, r);
+      double rmax = 0;  // ‖E r‖∞, the scale of the consistency test
+      for (int k = 0; k < cp.nrows; ++k) {
+        r[k] *= cp.E[k];
+        rmax = std::max(rmax, std::abs(r[k]));
+      }
+      applyQt(cp, r);
+      const double tol = o.consistency_tol * std::max(1.0, rmax);
+      if (cp.soft) {
+        double res;
+        if (!softCompressionRhs(cp, r, tol, res) && check) {
+          ws.failure = {true, i, e, res};
+          return false;
+        }
+        continue;
+      }
+      cp.rhs.resize(cp.rank);
+      for (int k = 0; k < cp.rank; ++k) cp.rhs[k] = r[k];
+      if (check && cp.nrows > cp.rank) {
+        // The dropped rows are combinations of the kept ones: their right
+        // sides must be the same combinations, or no acceleration satisfies them.
+        double res = 0;
+        for (int k = cp.rank; k < cp.nrows; ++k) res = std::max(res, std::abs(r[k]));
+        if (res > tol) {
+          ws.failure = {true, i, e, res};
+          return false;
+        }
+      }
+    }
+    if (nd.ncomp > 0)
+      nd.k = nd.comp[nd.ncomp - 1].rhs;
+    else
+      nd.k.resize(0);
+
+    if (nd.soft) {
+      Vec6 pa;
+      softBias(j, nd, ws.tau, pa);
+      if (p >= 0) {
+        if (ws.use_c) pa += nd.Hc;
+        ws.nodes[p].pA += data.liMi[i].actForce(pa);
+      }
+      nd.kpass = nd.kv.head(nd.npass);
+      if (ws.use_c && nd.npass > 0) nd.kpass -= nd.kpc;
+      continue;
+    }
+    const auto tau = ws.tau.segment(j.idx_v, j.nv);
+    if (nd.nf > 0) {
+      if (nd.rankG > 0)
+        nd.u.noalias() = nd.V2.transpose() * tau;
+      else
+        nd.u = tau;
+      nd.u.noalias() -= nd.S2.transpose() * nd.pA;
+    }
+    if (p >= 0) {
+      Vec6 pa = nd.pA;
+      if (nd.nf > 0) pa.noalias() += nd.U * (nd.Dinv * nd.u);
+      // Gradient of the child's cost-to-go in ā = X a_p + c:
+      //   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ,   d = S G⁺ k,
+      // with Pᵀ x = x − GKᵀ(Sᵀ x) and Kᵀ G⁺ᵀ = GKᵀ:  H ā + x − GKᵀ(Sᵀx − τ).
+      Vec6 g = ws.use_c ? nd.Hc : Vec6::Zero();
+      if (nd.rankG > 0 && j.nv == 1) {
+        pa += nd.gp.dot(nd.k) * nd.ias;
+        g -= (j.S.col(0).dot(pa) - tau[0]) * nd.gk;
+      } else if (nd.rankG > 0) {
+        KVec y(j.nv);
+        y.noalias() = nd.Gpinv * nd.k;
+        pa.noalias() += nd.IaS * y;
+        KVec sx(j.nv);
+        sx.noalias() = j.S.transpose() * pa;
+        sx -= tau;
+        g.noalias() -= nd.GK.transpose() * sx;
+      }
+      g += pa;
+      ws.nodes[p].pA += data.liMi[i].actForce(g);
+    }
+    if (nd.npass > 0) {
+      applyU2t(nd, nd.k, nd.kpass);
+      if (ws.use_c) nd.kpass -= nd.kpc;
+    } else {
+      nd.kpass.resize(0);
+    }
+  }
+  return true;
+}
+
+}  // namespace appell::detail

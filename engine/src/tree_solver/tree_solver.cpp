@@ -1,0 +1,215 @@
+// Tree solver: set-up, and the two solves (dynamics, velocity projection)
+// built from the passes in tree_solver/{backward,forward,multipliers,loops}.cpp.
+#include <appell/kinematics.hpp>
+#include <appell/tree_solver.hpp>
+
+#include "tree_solver/workspace.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace appell {
+
+using detail::Segment;
+
+TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
+                       const SolverOptions& options)
+    : ws_(std::make_unique<detail::TreeWorkspace>()) {
+  auto& ws = *ws_;
+  ws.options = options;
+  ws.nbodies = model.nbodies;
+  ws.nv = model.nv;
+  ws.nodes.resize(model.nbodies);
+
+  int global = 0;
+  for (size_t c = 0; c < constraints.size(); ++c) {
+    const Constraint& con = *constraints[c];
+    ws.names.push_back(con.name());
+    const int rows = con.rows();
+    const int A = con.bodyA(), B = con.bodyB();
+    auto fail = [&](const std::string& why) {
+      throw std::invalid_argument("TreeSolver: constraint '" + con.name() + "' " + why);
+    };
+    if (rows < 0) fail("has a negative row count");
+    if (!con.jointSpace()) {
+      if (A >= model.nbodies || B >= model.nbodies)
+        fail("acts on a body index outside the model (" + std::to_string(model.nbodies) +
+             " bodies)");
+      if (A < 0 && B < 0) fail("acts on no moving body (both bodies are the world)");
+      if (rows > 6) fail("writes " + std::to_string(rows) + " body rows (at most 6)");
+    }
+    if (con.jointSpace() || (A >= 0 && B >= 0)) {
+      for (int r = 0; r < rows; ++r)
+        ws.loops.push_back({static_cast<int>(c), r, global + r, con.jointSpace(), A, B});
+    } else if (rows > 0) {
+      detail::TreeBlock tb;
+      tb.constraint = static_cast<int>(c);
+      tb.body = A >= 0 ? A : B;
+      tb.sign = A >= 0 ? 1.0 : -1.0;
+      tb.rows = rows;
+      tb.global = global;
+      tb.rhs.setZero(rows);
+      ws.nodes[tb.body].groups.push_back({Segment::Block, static_cast<int>(ws.blocks.size()), rows});
+      ws.blocks.push_back(tb);
+    }
+    global += rows;
+  }
+  ws.m = global;
+  for (int i = 0; i < model.nbodies; ++i)
+    for (int ch : model.children[i]) ws.nodes[i].groups.push_back({Segment::Child, ch, 0});
+  for (auto& nd : ws.nodes) {
+    nd.comp.resize(nd.groups.size() + 1);
+    nd.K.resize(0, 6);
+    nd.k.resize(0);
+    nd.nu.resize(0);
+    nd.bias0.setZero();
+    nd.c.setZero();
+    nd.a.setZero();
+  }
+  ws.tau = VecX::Zero(model.nv);
+  ws.a_world.setZero();
+  ws.vdot = VecX::Zero(model.nv);
+  ws.lambda = VecX::Zero(ws.m);
+  ws.fsub.assign(model.nbodies, Vec6::Zero());
+  ws.floop.assign(model.nbodies, Vec6::Zero());
+  ws.a0.assign(model.nbodies, Vec6::Zero());
+  const int k = static_cast<int>(ws.loops.size());
+  if (k > 0) {
+    ws.W = MatX::Zero(model.nv, k);
+    ws.L = MatX::Zero(ws.m, k);
+    ws.Z = MatX::Zero(6 * model.nbodies, k);
+    ws.z_svd = decltype(ws.z_svd)(6 * model.nbodies, k, Eigen::ComputeThinV);
+    // R_i = Λ^½ Vᵀ from I_i = V Λ Vᵀ: also for a body whose inertia is only
+    // semidefinite (a massless frame, a point mass).
+    ws.inertia_root.resize(model.nbodies);
+    for (int i = 0; i < model.nbodies; ++i) {
+      const Eigen::SelfAdjointEigenSolver<Mat6> es(model.spatial_inertia[i]);
+      ws.inertia_root[i] = es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() *
+                           es.eigenvectors().transpose();
+    }
+    ws.vdot0 = VecX::Zero(model.nv);
+    ws.lambda0 = VecX::Zero(ws.m);
+    for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp, &ws.loop_resid, &ws.loop_share, &ws.loop_fnorm})
+      *x = VecX::Zero(k);
+  }
+}
+
+TreeSolver::~TreeSolver() = default;
+
+int TreeSolver::loopRows() const { return static_cast<int>(ws_->loops.size()); }
+const std::string& TreeSolver::lastError() const { return ws_->last_error; }
+
+namespace {
+
+void checkSizes(const Model& model, const ConstraintData& cdata, const detail::TreeWorkspace& ws) {
+  if (model.nbodies != ws.nbodies || model.nv != ws.nv || cdata.m != ws.m)
+    throw std::invalid_argument(
+        "TreeSolver: the model or constraint set differs from the one the solver was built for");
+}
+
+/// Velocity products and bias forces of the current state (ABA's first pass).
+void velocityTerms(const Model& model, const Data& data, const VecX& v, detail::TreeWorkspace& ws) {
+  for (int i = 0; i < model.nbodies; ++i) {
+    const Joint& j = model.joints[i];
+    auto& nd = ws.nodes[i];
+    nd.c = crossMotion(data.v[i], j.S * v.segment(j.idx_v, j.nv));
+    nd.bias0 = crossForce(data.v[i], model.spatial_inertia[i] * data.v[i]);
+  }
+}
+
+}  // namespace
+
+void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& constraints,
+                       ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
+                       ConstrainedResult& out) {
+  (void)constraints;
+  auto& ws = *ws_;
+  checkSizes(model, cdata, ws);
+  if (out.vdot.size() != model.nv) out.vdot.resize(model.nv);
+  if (out.lambda.size() != ws.m) out.lambda.resize(ws.m);
+  if (out.reaction.size() != model.nv) out.reaction.resize(model.nv);
+  out.ok = true;
+  out.error.clear();
+  if (cdata.singular) {
+    out.ok = false;
+    out.error = "singular constraint geometry: " + cdata.singular_reason;
+    return;
+  }
+
+  forwardKinematics(model, data, q, v);
+  velocityTerms(model, data, v, ws);
+  detail::factorPass(model, data, cdata, ws);
+  // Right sides on the gravity-shifted accelerations a' = a − g (ABA's trick):
+  // w·a + κ = 0  ⇔  w·a' = −κ − w_lin·g.
+  for (auto& tb : ws.blocks) {
+    const RowBlock& blk = cdata.blocks[tb.constraint];
+    const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
+    for (int r = 0; r < tb.rows; ++r)
+      tb.rhs[r] = -blk.kappa[r] - tb.sign * W.row(r).tail<3>().dot(model.gravity);
+  }
+  ws.tau = tau;
+  ws.a_world = spatial(Vec3::Zero(), -model.gravity);
+  ws.use_c = true;
+  ws.lambda.setZero();
+  detail::loopTargets(model, data, cdata, ws, v, false);
+  if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||
+      !detail::solveLoops(model, data, cdata, ws)) {
+    out.ok = false;
+    out.error = detail::describeFailure(model, data, ws);
+    return;
+  }
+  ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;
+  out.vdot = ws.vdot;
+  out.lambda = ws.lambda;
+  detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
+  out.redundant = ws.redundant;
+  out.rank = ws.m - ws.redundant;
+}
+
+bool TreeSolver::projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,
+                                 ConstraintData& cdata, const VecX& q, VecX& v, VecX& impulse) {
+  (void)constraints;
+  auto& ws = *ws_;
+  checkSizes(model, cdata, ws);
+  ws.last_error.clear();
+  if (cdata.singular) {
+    ws.last_error = "singular constraint geometry: " + cdata.singular_reason;
+    return false;
+  }
+  if (impulse.size() != ws.m) impulse.resize(ws.m);
+
+  // min ½‖Δ‖²_M  s.t.  A Δ = −(A v + b): the dynamics problem with no forces,
+  // no velocity products, no gravity, and the velocity residual as right side.
+  forwardKinematics(model, data, q, v);
+  detail::factorPass(model, data, cdata, ws);
+  for (auto& nd : ws.nodes) nd.bias0.setZero();
+  for (auto& tb : ws.blocks) {
+    const RowBlock& blk = cdata.blocks[tb.constraint];
+    const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
+    const Vec6 V = data.oMi[tb.body].act(data.v[tb.body]);
+    for (int r = 0; r < tb.rows; ++r) tb.rhs[r] = -(tb.sign * W.row(r).dot(V) + blk.b[r]);
+  }
+  ws.tau.setZero();
+  ws.a_world.setZero();
+  ws.use_c = false;
+  ws.lambda.setZero();
+  detail::loopTargets(model, data, cdata, ws, v, true);
+  if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||
+      !detail::solveLoops(model, data, cdata, ws)) {
+    ws.last_error = detail::describeFailure(model, data, ws);
+    return false;
+  }
+  v += ws.vdot;
+  impulse = -ws.lambda;  // the shared convention: v⁺ = v − M⁻¹Aᵀμ
+  return true;
+}
+
+std::unique_ptr<ConstrainedSolver> makeTreeSolver(const Model& model,
+                                                  const ConstraintList& constraints,
+                                                  const SolverOptions& options) {
+  return std::make_unique<TreeSolver>(model, constraints, options);
+}
+
+}  // namespace appell

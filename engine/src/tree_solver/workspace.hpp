@@ -1,0 +1,314 @@
+// Private workspace of the tree solver (tree_solver.hpp): every per-body and
+// per-row quantity of the passes, sized once by the constructor. All small
+// matrices have compile-time maximum sizes, so the passes never allocate.
+#pragma once
+
+#include <appell/tree_solver.hpp>
+
+#include "solvers/pivoted_qr.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
+
+namespace appell::detail {
+
+// Row stacks: at most 6 rows after compression, at most 12 while stacking
+// (stacked in PivotedQR's own storage).
+using KRows = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
+using KVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+using BufVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 12, 1>;
+using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+using StackMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12>;
+
+/// A kept singular value of K S below this (rows equilibrated, S unit) is a
+/// joint that can barely move its rows: the rows are not resolved there but
+/// handed up with their compliance (tree_solver/soft.cpp).
+constexpr double kWeakPivot = 5e-2;
+
+/// One piece of a node's row stack: the output of the previous compression,
+/// one constraint's own rows, or one child's unresolved rows.
+struct Segment {
+  enum Kind { Previous, Block, Child } kind = Previous;
+  int id = -1;    ///< block index (into TreeWorkspace::blocks) or child body
+  int rows = 0;
+};
+
+/// One rank-revealing compression  Qᵀ E [stacked rows] Π = [R₁; ≈0], K = R₁ Πᵀ.
+/// The rows are stacked straight into the factorization's storage and
+/// Q = H₀ H₁ ⋯ H_{rank−1} stays there as its Householder reflectors
+/// (pivoted_qr.hpp); applying them costs O(nrows · rank) per vector where
+/// forming Q costs O(nrows² · 6).
+struct Compression {
+  int nrows = 0;               ///< rows stacked
+  int rank = 0;                ///< rows kept = reflectors stored
+  PivotedQR f;                 ///< R, reflectors, scalars τ and column pivots Π
+  BufVec E;                    ///< row equilibration scales
+  int nseg = 0;
+  std::array<Segment, 13> seg;
+  KVec rhs;                    ///< kept right sides (bias pass)
+  KVec mu;                     ///< multipliers of the kept rows (forward pass)
+
+  // Compliant rows (tree_solver/soft.cpp): a stacked segment carried a
+  // compliance Φ = F Fᵀ (kept as its square-root factor F), so the dropped
+  // combinations (K part ≈ 0) may still involve multipliers:
+  // Φ_dk μ_k + Φ_dd μ_d = r_d,  F_d = U_d Σ_d W_dᵀ.
+  bool soft = false;
+  int nelim = 0;               ///< dropped directions with compliance (eliminated here)
+  SmallMat F;                  ///< rank × rank factor of the kept rows' compliance
+  StackMat Ud;                 ///< left singular vectors of F_d: eliminated, then redundant
+  BufVec sInv;                 ///< 1/Σ_e of the eliminated directions
+  StackMat FkWe;               ///< F_k W_e (rank × nelim)
+  BufVec rd;                   ///< dropped right sides Q₂ᵀ E r of the last bias pass
+};
+
+/// A constraint whose rows act on one body of the tree.
+struct TreeBlock {
+  int constraint = -1;         ///< index in the ConstraintList / ConstraintData
+  int body = -1;
+  double sign = 1;             ///< +1: rows Wₐ on bodyA; −1: rows −W_b on bodyB
+  int rows = 0;
+  int global = -1;             ///< first row in ConstraintData
+  KVec rhs;                    ///< right side on the gravity-shifted acceleration
+};
+
+/// A row closing a loop: two moving bodies, or given over v (joint space).
+struct LoopRow {
+  int constraint = -1;
+  int row = -1;                ///< row within the constraint
+  int global = -1;             ///< row in ConstraintData
+  bool joint_space = false;
+  int bodyA = -1, bodyB = -1;
+};
+
+/// x ← H_k x, H_k = 1 − τ v vᵀ with v = [0…0, 1, essential] (reflector k of
+/// the compression's QR, Eigen's storage). Written out: Eigen's generic
+/// applyHouseholderOnTheLeft costs several times more on these short vectors.
+inline void applyReflector(const Compression& cp, int k, BufVec& x) {
+  const double tau = cp.f.tau[k];
+  const int pk = cp.f.perm[k];
+  double t = x[k];
+  for (int r = k + 1; r < cp.nrows; ++r) t += cp.f.a[r][pk] * x[r];
+  t *= tau;
+  x[k] -= t;
+  for (int r = k + 1; r < cp.nrows; ++r) x[r] -= t * cp.f.a[r][pk];
+}
+
+/// x ← Qᵀ x (x has cp.nrows entries): H₀ first.
+inline void applyQt(const Compression& cp, BufVec& x) {
+  for (int k = 0; k < cp.rank; ++k) applyReflector(cp, k, x);
+}
+
+/// x ← Q x (x has cp.nrows entries): the last reflector first.
+inline void applyQ(const Compression& cp, BufVec& x) {
+  for (int k = cp.rank - 1; k >= 0; --k) applyReflector(cp, k, x);
+}
+
+/// How U₂, the left null space of K S (rows handed to the parent), is held.
+enum class U2Form {
+  Identity,   ///< the joint resolves no row: U₂ = 1 (or nothing is left)
+  Reflector,  ///< one-DoF joint: columns 1… of H = 1 − β u uᵀ
+  Explicit,   ///< the SVD's columns, in U2
+};
+
+struct Node {
+  // Ordered by use, not by pass: what every body touches in every solve
+  // first and together (fewer cache lines per body), what only multi-DoF or
+  // unresolved joints use last.
+  int ncomp = 0;
+  int nK = 0;                             ///< compressed rows at this body
+  int rankG = 0;                          ///< rows the joint resolves
+  int npass = 0, nf = 0;                  ///< rows handed up; free joint directions
+  U2Form u2form = U2Form::Identity;
+  double hbeta = 0;                       ///< reflector scalar β (U2Form::Reflector)
+  Vec6 Hc;                                ///< H c, H = Pᵀ Ia P what the parent sees
+  Vec6 bias0;                             ///< initial bias force (v ×* I v, or unit forces)
+  Vec6 pA;                                ///< articulated bias before the joint
+  Vec6 c;                                 ///< velocity-product acceleration v × S q̇
+  Vec6 a;                                 ///< acceleration (gravity-shifted)
+  // One-DoF joint with its row resolved (the common case), kept compact:
+  KVec gp;                                ///< G⁺ᵀ = g/σ² (nK), g = K s
+  Vec6 gk;                                ///< GKᵀ = Kᵀ G⁺ᵀ (not at the root)
+  Vec6 ias;                               ///< IA s (not at the root)
+  KVec hu;                                ///< reflector vector (U2Form::Reflector)
+  KVec k;                                 ///< right sides of K
+  KVec kpass;                             ///< right sides of the handed-up rows (on a_parent)
+  KVec kpc;                               ///< Kpass c, their velocity-product part
+  KVec nu;                                ///< multipliers of the handed-up rows
+
+  // Factors (depend on q and the rows only).
+  KRows K;                                ///< compressed rows, body frame
+  KRows Kpass;                            ///< U2ᵀ K, this body's frame
+  SmallMat Gpinv;                         ///< (K S)⁺ truncated at the rank, nv × nK (nv > 1)
+  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6> GK;  ///< G⁺ K (nv × 6): P = 1 − S GK (nv > 1)
+  Mat6X IaS;                              ///< Ia S, Ia = IA − U D⁻¹ Uᵀ (ρ > 0, nv > 1, not the root)
+  Mat6 IA;                                ///< articulated inertia before the joint
+
+  // Free directions and general splits.
+  SmallMat U2;                            ///< nK × npass (U2Form::Explicit)
+  SmallMat V2;                            ///< nv × nf, right null space of K S
+  Mat6X S2, U;                            ///< S V2 and IA S V2
+  SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
+  KVec u;                                 ///< V2ᵀ τ − S2ᵀ pA
+
+  // Compliant elimination (tree_solver/soft.cpp): the joint is eliminated as
+  // in ABA with the rows carried, K' a − Φ' λ = k'; directions of Φ' large
+  // enough are resolved here, the rest handed up with their compliance.
+  bool soft = false;
+  bool softpass = false;                  ///< some handed-up row has compliance > 0
+  KVec fpass;                             ///< √compliance of the handed-up rows (diagonal)
+  SmallMat GD;                            ///< G D⁻¹ (nK × nv), G = K S
+  SmallMat Vphi;                          ///< eigenvectors of Φ': handed up, then resolved
+  KRows Kel;                              ///< resolved rows V₁ᵀ K'
+  KVec lamInv;                            ///< 1/Λ₁
+  KVec kv;                                ///< Vphiᵀ k' (bias pass)
+
+  std::vector<Segment> groups;            ///< own blocks, then children
+  std::vector<Compression> comp;          ///< sized groups.size() + 1
+};
+
+/// y = U₂ᵀ x: right sides of the rows handed to the parent.
+inline void applyU2t(const Node& nd, const KVec& x, KVec& y) {
+  switch (nd.u2form) {
+    case U2Form::Identity: y = x.head(nd.npass); break;
+    case U2Form::Reflector: {
+      const double t = nd.hbeta * nd.hu.dot(x);
+      y = x.tail(nd.npass);
+      y.noalias() -= t * nd.hu.tail(nd.npass);
+      break;
+    }
+    case U2Form::Explicit: y.noalias() = nd.U2.transpose() * x; break;
+  }
+}
+
+/// y += U₂ ν: multipliers of the handed-up rows back on K.
+inline void addU2(const Node& nd, const KVec& nu, KVec& y) {
+  switch (nd.u2form) {
+    case U2Form::Identity: y.head(nd.npass) += nu; break;
+    case U2Form::Reflector: {
+      const double t = nd.hbeta * nd.hu.tail(nd.npass).dot(nu);
+      y.tail(nd.npass) += nu;
+      y.noalias() -= t * nd.hu;
+      break;
+    }
+    case U2Form::Explicit: y.noalias() += nd.U2 * nu; break;
+  }
+}
+
+struct Failure {
+  bool failed = false;
+  int node = -1;                          ///< body where rows turned out inconsistent
+  int comp = -1;                          ///< compression index, −1: at the world
+  double residual = 0;
+};
+
+struct TreeWorkspace {
+  SolverOptions options;
+  int nbodies = 0, nv = 0, m = 0;
+  std::vector<Node> nodes;
+  std::vector<TreeBlock> blocks;
+  std::vector<LoopRow> loops;
+  std::vector<std::string> names;         ///< constraint names, for messages
+
+  // Solver scratch with compile-time maximum sizes.
+  Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
+
+  // Right sides of one pass.
+  VecX tau;                               ///< generalized force of the pass
+  Vec6 a_world;                           ///< world acceleration (world frame)
+  bool use_c = true;
+
+  // Outputs of one pass.
+  VecX vdot, lambda;
+  int redundant = 0;
+  Failure failure;
+  /// Compliance factors (tree_solver/soft.cpp): F' of a joint, F_d, F_k of a stack.
+  Eigen::JacobiSVD<StackMat, Eigen::ColPivHouseholderQRPreconditioner> svd12;
+
+  // Loop closure: k unit solves and the square root of the Schur complement.
+  MatX W;                                 ///< nv × k, response to each loop row's force
+  MatX L;                                 ///< m × k, tree multipliers of each response
+  MatX Z;                                 ///< 6n × k, [R_i a_i] per response: S = Zᵀ Z
+  std::vector<Mat6> inertia_root;         ///< R_i with I_i = R_iᵀ R_i (body frame, constant)
+  Eigen::JacobiSVD<MatX, Eigen::ColPivHouseholderQRPreconditioner> z_svd;
+  VecX vdot0, lambda0, loop_target, loop_rhs, loop_res, loop_scale, loop_lambda, loop_tmp, loop_resid;
+  VecX loop_share, loop_fnorm;             ///< free share and norm of each loop row's force
+  std::vector<Vec6> a0;                   ///< body accelerations of the main pass
+  std::vector<Vec6> fsub;                 ///< subtree constraint forces (world frame)
+  std::vector<Vec6> floop;                ///< subtree loop-row force (body frame, freeShare)
+  int loop_rank = 0;
+
+  std::string last_error;
+};
+
+/// Right sides of the rows stacked in compression e of body i, before
+/// equilibration: the previous compression's kept rows, constraint blocks and
+/// children's handed-up rows, in stacking order.
+inline void gatherRhs(const TreeWorkspace& ws, int i, int e, BufVec& r) {
+  const Node& nd = ws.nodes[i];
+  const Compression& cp = nd.comp[e];
+  r.resize(cp.nrows);
+  double* out = r.data();
+  for (int s = 0; s < cp.nseg; ++s) {
+    const Segment& g = cp.seg[s];
+    const double* in = g.kind == Segment::Previous ? nd.comp[e - 1].rhs.data()
+                       : g.kind == Segment::Block  ? ws.blocks[g.id].rhs.data()
+                                                   : ws.nodes[g.id].kpass.data();
+    for (int k = 0; k < g.rows; ++k) *out++ = in[k];
+  }
+}
+
+// Passes (tree_solver/backward.cpp, tree_solver/forward.cpp, tree_solver/loops.cpp).
+void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
+                TreeWorkspace& ws);
+/// Right-side pass; with `check`, returns false (ws.failure) on inconsistent rows.
+bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check);
+/// Accelerations and multipliers (ws.vdot, ws.lambda for tree rows); with
+/// `check`, tests the rows handed to the world and returns false on a mismatch.
+bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check);
+/// Multipliers of the stacked rows of compressions `from` … 0 of `body`
+/// (comp[from].mu set): λ_stack = E Q₁ μ, the adjoint of the compression,
+/// written to the body's own rows in `lambda` and to its children's `nu`.
+void unrollNode(TreeWorkspace& ws, int body, int from, VecX& lambda);
+/// Aᵀλ in O(n + m): row forces summed as world spatial forces over each
+/// subtree, projected on each joint's motion subspace.
+void reactionForces(const Model& model, const Data& data, const ConstraintData& cdata,
+                    TreeWorkspace& ws, const VecX& lambda, VecX& reaction);
+/// Solves the loop rows (right sides ws.loop_target) on top of the main pass
+/// (ws.vdot, ws.lambda, body accelerations). Returns false (ws.failure,
+/// ws.last_error) when inconsistent.
+bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdata,
+                TreeWorkspace& ws);
+/// Right sides of the loop rows (ws.loop_target) for the dynamics or, with
+/// `impulse`, the velocity projection.
+void loopTargets(const Model& model, const Data& data, const ConstraintData& cdata,
+                 TreeWorkspace& ws, const VecX& v, bool impulse);
+
+// Compliant rows (tree_solver/soft.cpp).
+/// After compress(): the stack's compliance factor carried through Q, the
+/// dropped combinations with compliance eliminated. Returns the truly
+/// redundant count.
+int softCompress(TreeWorkspace& ws, int body, int e);
+/// Whether a segment of a stack carries compliance.
+bool softSegment(const TreeWorkspace& ws, const Node& nd, int e, const Segment& g);
+/// Joint split with rows carried (ABA elimination, then Φ' split); H for the parent.
+void splitSoft(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H);
+/// Right sides through a compliant compression; false if the redundant part
+/// is inconsistent (residual in `res`).
+bool softCompressionRhs(Compression& cp, const BufVec& t, double tol, double& res);
+/// Multipliers of a compliant compression's dropped rows, into lam[rank…].
+void softDroppedMultipliers(const Compression& cp, BufVec& lam);
+/// Bias pass of a compliant node: its gradient contribution g for the parent
+/// (without H c) and its handed-up right sides.
+void softBias(const Joint& j, Node& nd, const VecX& tau, Vec6& pa);
+/// Forward pass of a compliant node: q̈, a, and the multipliers of its rows.
+void softForward(const Joint& j, Node& nd, const Vec6& abar, VecX& vdot);
+/// "…" message naming the constraints involved in the inconsistency of ws.failure.
+std::string describeFailure(const Model& model, const Data& data, TreeWorkspace& ws);
+
+}  // namespace appell::detail

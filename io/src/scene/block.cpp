@@ -1,0 +1,302 @@
+// Parsing of the `<appell>` scene block (docs/scene-format.md).
+#include "scene/block.hpp"
+
+#include <appell/integrators.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace appell::io {
+
+namespace {
+
+Vec3 unitVector(const XmlSource& src, const TiXmlElement* e, const char* attr, const Vec3& fallback) {
+  const Vec3 v = vec3(src, e, attr, fallback);
+  if (v.norm() < 1e-12) fail(src, e, std::string("'") + attr + "' is a zero vector");
+  return v.normalized();
+}
+
+double positive(const XmlSource& src, const TiXmlElement* e, const char* attr) {
+  const double x = number(src, e, attr);
+  if (x <= 0) fail(src, e, std::string("'") + attr + "' must be positive");
+  return x;
+}
+
+SupportMotion parseMotion(const XmlSource& src, const TiXmlElement* support) {
+  SupportMotion motion = StaticMotion{};
+  int count = 0;
+  for (const TiXmlElement* m = support->FirstChildElement(); m; m = m->NextSiblingElement()) {
+    const std::string tag = m->Value();
+    ++count;
+    if (count > 1) fail(src, m, "a support has at most one motion element");
+    if (tag == "turntable") {
+      allowOnly(src, m, {"rate", "axis", "center"});
+      motion = turntable(vec3(src, m, "center", Vec3::Zero()),
+                         unitVector(src, m, "axis", Vec3::UnitZ()), number(src, m, "rate"));
+    } else if (tag == "conveyor") {
+      allowOnly(src, m, {"velocity"});
+      motion = conveyor(vec3(src, m, "velocity"));
+    } else if (tag == "twist") {
+      allowOnly(src, m, {"angular", "linear"});
+      ConstantTwistMotion t;
+      // Read both before the comma initializer: a throw inside it would
+      // leave Eigen's initializer half-filled (an assertion in debug builds).
+      const Vec3 w = vec3(src, m, "angular", Vec3::Zero()), u = vec3(src, m, "linear", Vec3::Zero());
+      t.twist << w, u;
+      motion = t;
+    } else if (tag == "tilt") {
+      allowOnly(src, m, {"axis", "point", "amplitude", "frequency", "phase"});
+      SinusoidalTiltMotion t;
+      t.point = vec3(src, m, "point", Vec3::Zero());
+      t.axis = unitVector(src, m, "axis", Vec3::UnitX());
+      t.amplitude = number(src, m, "amplitude");
+      t.frequency = number(src, m, "frequency");
+      t.phase = number(src, m, "phase", 0.0);
+      motion = t;
+    } else {
+      fail(src, m, "unknown support motion <" + tag + "> (known: turntable, conveyor, twist, tilt)");
+    }
+  }
+  return motion;
+}
+
+SupportDecl parseSupport(const XmlSource& src, const TiXmlElement* e, const std::string& base_dir,
+                         const LoadOptions& options) {
+  SupportDecl d;
+  d.element = e;
+  d.name = text(src, e, "name");
+  if (d.name.empty()) fail(src, e, "empty support name");
+  const std::string type = text(e, "type", "plane");
+  d.support.name = d.name;
+  if (type == "plane") {
+    allowOnly(src, e, {"name", "type", "normal", "offset", "point"});
+    Plane p;
+    p.normal = unitVector(src, e, "normal", Vec3::UnitZ());
+    if (has(e, "point") && has(e, "offset"))
+      fail(src, e, "give either 'point' or 'offset', not both");
+    p.point = has(e, "point") ? vec3(src, e, "point") : number(src, e, "offset", 0.0) * p.normal;
+    d.support.surface = p;
+  } else if (type == "bowl" || type == "sphere") {
+    allowOnly(src, e, {"name", "type", "center", "radius"});
+    SphereSurface s;
+    s.centre = vec3(src, e, "center", Vec3::Zero());
+    s.radius = positive(src, e, "radius");
+    s.side = type == "bowl" ? SphereSurface::Side::Inside : SphereSurface::Side::Outside;
+    d.support.surface = s;
+  } else if (type == "terrain") {
+    allowOnly(src, e, {"name", "type", "filename", "scale"});
+    d.terrain = true;
+    const std::string uri = text(src, e, "filename");
+    const Vec3 scale = vec3(src, e, "scale", Vec3::Ones());
+    try {
+      d.terrain_path = resolveMeshPath(uri, base_dir, options);
+      d.terrain_mesh = std::make_shared<const TriangleMesh>(loadMesh(d.terrain_path, scale));
+    } catch (const SceneError& err) {
+      fail(src, e, err.what());
+    }
+  } else {
+    fail(src, e, "unknown support type '" + type + "' (known: plane, bowl, sphere, terrain)");
+  }
+  d.support.motion = parseMotion(src, e);
+  if (d.terrain && isMoving(d.support.motion)) fail(src, e, "a terrain cannot move");
+  return d;
+}
+
+ContactKind parseKind(const XmlSource& src, const TiXmlElement* e) {
+  std::string k = text(e, "kind", "rolling");
+  std::replace(k.begin(), k.end(), '-', '_');
+  if (k == "rolling_no_spin") k = "rolling_without_spin";
+  try {
+    return contactKindFromString(k);
+  } catch (const std::invalid_argument&) {
+    fail(src, e, "unknown contact kind '" + text(e, "kind", "") +
+                     "' (known: rolling, rolling_without_spin, knife_edge, sliding)");
+  }
+}
+
+// Pose of an explicit shape in the link frame: xyz (centre) and, for the
+// ellipsoid, rpy (its semi-axes along the rotated x, y, z).
+std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement* e) {
+  const bool has_shape = has(e, "shape"), has_point = has(e, "point");
+  if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
+  static const char* const kCommon[] = {"name", "link", "kind", "support", "mu", "direction"};
+  auto allow = [&](std::initializer_list<const char*> extra) {
+    for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+      const std::string n = a->Name();
+      bool ok = false;
+      for (const char* c : kCommon) ok = ok || n == c;
+      for (const char* c : extra) ok = ok || n == c;
+      if (!ok)
+        fail(src, e, "attribute '" + n + "' does not apply to " +
+                         (has_point ? std::string("a point contact")
+                          : has_shape ? "shape=\"" + text(e, "shape", "") + "\""
+                                      : std::string("a shape taken from the collision geometry")));
+    }
+  };
+  if (has_point) {
+    allow({"point"});
+    return Shape{PointShape{vec3(src, e, "point")}};
+  }
+  if (!has_shape) {
+    allow({"collision", "tyre_radius"});
+    return std::nullopt;
+  }
+  const std::string type = text(src, e, "shape");
+  if (type == "sphere") allow({"shape", "radius", "xyz"});
+  if (type == "ellipsoid") allow({"shape", "semi_axes", "xyz", "rpy"});
+  if (type == "disk" || type == "hemisphere") allow({"shape", "radius", "xyz", "axis"});
+  if (type == "torus") allow({"shape", "radius", "tyre_radius", "xyz", "axis"});
+  if (type == "cap") allow({"shape", "radius", "xyz", "axis", "half_angle"});
+  const Vec3 c = vec3(src, e, "xyz", Vec3::Zero());
+  if (type == "sphere") return Shape{Sphere{positive(src, e, "radius"), c}};
+  if (type == "ellipsoid") {
+    Ellipsoid el;
+    el.semi_axes = vec3(src, e, "semi_axes");
+    if (el.semi_axes.minCoeff() <= 0) fail(src, e, "'semi_axes' must be positive");
+    el.centre = c;
+    el.orientation = rpyToMatrix(vec3(src, e, "rpy", Vec3::Zero()));
+    return Shape{el};
+  }
+  if (type == "disk") return Shape{Disk{positive(src, e, "radius"), c, unitVector(src, e, "axis", Vec3::UnitZ())}};
+  if (type == "torus") {
+    // `radius` is the wheel's outer radius, as for a cylinder collision with
+    // a tyre: the tube's centre circle has radius − tyre_radius.
+    Torus t;
+    const double outer = positive(src, e, "radius");
+    t.minor = positive(src, e, "tyre_radius");
+    if (t.minor >= outer) fail(src, e, "'tyre_radius' must be smaller than 'radius'");
+    t.major = outer - t.minor;
+    t.centre = c;
+    t.axis = unitVector(src, e, "axis", Vec3::UnitZ());
+    return Shape{t};
+  }
+  if (type == "hemisphere" || type == "cap") {
+    SphericalCap cap;
+    cap.radius = positive(src, e, "radius");
+    cap.centre = c;
+    cap.axis = unitVector(src, e, "axis", -Vec3::UnitZ());
+    cap.half_angle = type == "cap" ? positive(src, e, "half_angle") : M_PI / 2;
+    return Shape{cap};
+  }
+  fail(src, e, "unknown shape '" + type + "' (known: sphere, ellipsoid, disk, torus, hemisphere, cap)");
+}
+
+ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
+  ContactDecl d;
+  d.element = e;
+  d.name = text(src, e, "name");
+  if (d.name.empty()) fail(src, e, "empty contact name");
+  d.link = text(src, e, "link");
+  d.support = text(src, e, "support");
+  d.kind = parseKind(src, e);
+  d.shape = parseExplicitShape(src, e);
+  if (has(e, "direction")) {
+    d.has_direction = true;
+    d.blade_direction = vec3(src, e, "direction");
+    if (d.blade_direction.norm() < 1e-12) fail(src, e, "knife edge 'direction' is a zero vector");
+  }
+  if (has(e, "tyre_radius") && !(d.shape && std::holds_alternative<Torus>(*d.shape))) {
+    if (d.shape) fail(src, e, "'tyre_radius' applies to a cylinder collision or shape=\"torus\"");
+    d.tyre_radius = positive(src, e, "tyre_radius");
+  }
+  d.collision = text(e, "collision", "");
+  if (has(e, "mu")) {
+    d.mu = number(src, e, "mu");
+    if (d.mu < 0) fail(src, e, "friction coefficient 'mu' must not be negative");
+  }
+  if (d.kind == ContactKind::KnifeEdge && d.shape && std::holds_alternative<PointShape>(*d.shape) &&
+      !d.has_direction)
+    fail(src, e, "a knife edge on a point needs a blade 'direction'");
+  if (d.has_direction && d.kind != ContactKind::KnifeEdge)
+    fail(src, e, "'direction' is only meaningful for kind=\"knife_edge\"");
+  return d;
+}
+
+JointStateDecl parseJointState(const XmlSource& src, const TiXmlElement* e) {
+  allowOnly(src, e, {"name", "position", "velocity", "xyz", "rpy", "quat"});
+  JointStateDecl d;
+  d.element = e;
+  d.joint = text(src, e, "name");
+  if (has(e, "position")) d.position = numbers(src, e, "position");
+  if (has(e, "velocity")) d.velocity = numbers(src, e, "velocity");
+  if (has(e, "xyz")) d.xyz = vec3(src, e, "xyz");
+  if (has(e, "rpy")) d.rpy = vec3(src, e, "rpy");
+  if (has(e, "quat")) d.quat = numbers(src, e, "quat", 4);
+  if (d.position && (d.xyz || d.rpy || d.quat))
+    fail(src, e, "give either 'position' or 'xyz'/'rpy'/'quat', not both");
+  if (d.rpy && d.quat) fail(src, e, "give either 'rpy' or 'quat', not both");
+  return d;
+}
+
+SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
+  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation"});
+  SimulationSettings s;
+  s.integrator = text(e, "integrator", s.integrator);
+  try {
+    integratorFromString(s.integrator);
+  } catch (const std::invalid_argument& err) {
+    fail(src, e, err.what());
+  }
+  if (has(e, "dt")) s.dt = positive(src, e, "dt");
+  if (has(e, "tol")) s.tol = positive(src, e, "tol");
+  if (has(e, "duration")) s.duration = positive(src, e, "duration");
+  s.formulation = text(e, "formulation", s.formulation);
+  if (s.formulation != "tree" && s.formulation != "kkt" && s.formulation != "appell")
+    fail(src, e, "unknown formulation '" + s.formulation + "' (known: tree, kkt, appell)");
+  return s;
+}
+
+}  // namespace
+
+AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
+                             const std::string& base_dir, const LoadOptions& options) {
+  AppellBlock b;
+  b.element = robot->FirstChildElement("appell");
+  if (!b.element) return b;
+  allowOnly(src, b.element, {});
+  if (b.element->NextSiblingElement("appell")) fail(src, b.element->NextSiblingElement("appell"),
+                                                    "more than one <appell> block");
+  std::set<std::string> supports, contacts;
+  bool have_gravity = false, have_simulation = false;
+  for (const TiXmlElement* e = b.element->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string tag = e->Value();
+    if (tag == "gravity") {
+      allowOnly(src, e, {"xyz"});
+      if (have_gravity) fail(src, e, "gravity is given twice");
+      have_gravity = true;
+      b.gravity = vec3(src, e, "xyz");
+    } else if (tag == "support") {
+      SupportDecl d = parseSupport(src, e, base_dir, options);
+      if (!supports.insert(d.name).second) fail(src, e, "support name '" + d.name + "' is used twice");
+      b.supports.push_back(std::move(d));
+    } else if (tag == "contact") {
+      ContactDecl d = parseContact(src, e);
+      if (!contacts.insert(d.name).second) fail(src, e, "contact name '" + d.name + "' is used twice");
+      b.contacts.push_back(std::move(d));
+    } else if (tag == "initial") {
+      allowOnly(src, e, {});
+      for (const TiXmlElement* j = e->FirstChildElement(); j; j = j->NextSiblingElement()) {
+        if (std::string(j->Value()) != "joint")
+          fail(src, j, "unknown element in <initial> (only <joint> is allowed)");
+        b.initial.push_back(parseJointState(src, j));
+      }
+    } else if (tag == "effort") {
+      allowOnly(src, e, {"joint", "value"});
+      b.efforts.push_back({e, text(src, e, "joint"), numbers(src, e, "value")});
+    } else if (tag == "simulation") {
+      if (have_simulation) fail(src, e, "<simulation> is given twice");
+      have_simulation = true;
+      b.settings = parseSimulation(src, e);
+    } else {
+      fail(src, e, "unknown element <" + tag +
+                       "> in <appell> (known: gravity, support, contact, initial, effort, simulation)");
+    }
+  }
+  for (const ContactDecl& c : b.contacts)
+    if (!supports.count(c.support))
+      fail(src, c.element, "unknown support '" + c.support + "'");
+  return b;
+}
+
+}  // namespace appell::io

@@ -1,0 +1,64 @@
+// The `<appell>` block of a URDF, read into declarations that do not yet
+// know the model (gravity must be known before the model is built).
+#pragma once
+
+#include "urdf/urdf_internal.hpp"
+
+#include <optional>
+
+namespace appell::io {
+
+struct SupportDecl {
+  const TiXmlElement* element = nullptr;
+  std::string name;
+  bool terrain = false;            ///< a terrain mesh (buildSceneContents turns it into a TerrainMesh surface)
+  Support support;                 ///< when !terrain
+  std::shared_ptr<const TriangleMesh> terrain_mesh;
+  std::string terrain_path;
+};
+
+struct ContactDecl {
+  const TiXmlElement* element = nullptr;
+  std::string name, link, support;
+  ContactKind kind = ContactKind::Rolling;
+  std::optional<Shape> shape;      ///< explicit `shape=` or `point=`
+  Vec3 blade_direction = Vec3::Zero();
+  bool has_direction = false;
+  double tyre_radius = 0;          ///< > 0: a cylinder collision is a torus rim
+  std::string collision;           ///< `collision=`: name or index of the geometry to use
+  double mu = std::numeric_limits<double>::infinity();
+};
+
+struct JointStateDecl {
+  const TiXmlElement* element = nullptr;
+  std::string joint;
+  std::optional<std::vector<double>> position, velocity;
+  std::optional<Vec3> xyz, rpy;
+  std::optional<std::vector<double>> quat;  ///< x y z w
+};
+
+struct EffortDecl {
+  const TiXmlElement* element = nullptr;
+  std::string joint;
+  std::vector<double> value;
+};
+
+struct AppellBlock {
+  const TiXmlElement* element = nullptr;  ///< null when the URDF has no <appell>
+  Vec3 gravity{0, 0, -9.81};
+  std::vector<SupportDecl> supports;
+  std::vector<ContactDecl> contacts;
+  std::vector<JointStateDecl> initial;
+  std::vector<EffortDecl> efforts;
+  SimulationSettings settings;
+};
+
+/// Reads the <appell> child of <robot> (if any). Throws SceneError.
+AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
+                             const std::string& base_dir, const LoadOptions& options);
+
+/// Turns the declarations into the scene's supports, contacts, constraints,
+/// initial state and efforts, against the built model and link geometry.
+void buildSceneContents(const XmlSource& src, const AppellBlock& block, Scene& scene);
+
+}  // namespace appell::io

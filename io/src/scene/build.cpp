@@ -1,0 +1,183 @@
+// From the <appell> declarations to supports, contact constraints, the
+// initial state and the efforts, against the built model.
+#include "scene/block.hpp"
+
+#include <appell/configuration.hpp>
+
+#include <sstream>
+
+namespace appell::io {
+
+namespace {
+
+std::string geometryLabel(int k, const Geometry& g) {
+  return "collision[" + std::to_string(k) + "] (" + toString(g.type) +
+         (g.name.empty() ? "" : " '" + g.name + "'") + ")";
+}
+
+// A cylinder collision on a wheel is its rim: a thin disk in the cylinder's
+// mid-plane (or a torus whose outer radius is the cylinder's when the contact
+// gives a tyre radius). A sphere is itself. Boxes and meshes cannot roll.
+Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry& g,
+                      const std::string& label) {
+  const Vec3 axis = g.origin.R.col(2);
+  switch (g.type) {
+    case GeometryType::Sphere:
+      if (c.tyre_radius > 0) fail(src, c.element, "'tyre_radius' needs a cylinder, not " + label);
+      return Sphere{g.radius, g.origin.p};
+    case GeometryType::Cylinder:
+      if (c.tyre_radius > 0) {
+        if (c.tyre_radius >= g.radius)
+          fail(src, c.element, "'tyre_radius' must be smaller than the cylinder radius " +
+                                   std::to_string(g.radius) + " of " + label);
+        return Torus{g.radius - c.tyre_radius, c.tyre_radius, g.origin.p, axis};
+      }
+      return Disk{g.radius, g.origin.p, axis};
+    case GeometryType::Box:
+    case GeometryType::Mesh:
+      break;
+  }
+  fail(src, c.element, label + " cannot roll: it has edges or facets, no unique contact point; "
+                       "give a smooth 'shape' (sphere, ellipsoid, disk, torus, hemisphere) or a 'point'");
+}
+
+Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometry& geo,
+                   std::string& source) {
+  if (c.shape) {
+    if (!c.collision.empty()) fail(src, c.element, "give either 'collision' or an explicit shape, not both");
+    source = "explicit";
+    return *c.shape;
+  }
+  const auto& col = geo.collision;
+  if (col.empty())
+    fail(src, c.element, "link '" + c.link + "' has no collision geometry to take the contact "
+                         "shape from; give 'shape' or 'point'");
+  int pick = -1;
+  if (!c.collision.empty()) {
+    for (int k = 0; k < static_cast<int>(col.size()); ++k)
+      if (col[k].name == c.collision) pick = k;
+    if (pick < 0) {
+      bool finite = false;
+      const auto idx = parseNumber(c.collision, &finite);
+      if (idx && finite && *idx >= 0 && *idx < static_cast<double>(col.size()) &&
+          *idx == static_cast<int>(*idx))
+        pick = static_cast<int>(*idx);
+    }
+    if (pick < 0)
+      fail(src, c.element, "link '" + c.link + "' has no collision geometry named or numbered '" +
+                               c.collision + "'");
+  } else {
+    // The first geometry that can roll; if none can, the first one (whose
+    // error says why it cannot).
+    for (int k = 0; k < static_cast<int>(col.size()) && pick < 0; ++k)
+      if (col[k].type == GeometryType::Sphere || col[k].type == GeometryType::Cylinder) pick = k;
+    if (pick < 0) pick = 0;
+  }
+  source = geometryLabel(pick, col[pick]);
+  return shapeOfGeometry(src, c, col[pick], source);
+}
+
+void setJointState(const XmlSource& src, const Model& model, const JointStateDecl& d, VecX& q,
+                   VecX& v) {
+  const int j = model.jointIndex(d.joint);
+  if (j < 0) fail(src, d.element, "unknown joint '" + d.joint + "'");
+  const Joint& joint = model.joints[j];
+  auto qs = q.segment(joint.idx_q, joint.nq);
+  if (d.position) {
+    if (static_cast<int>(d.position->size()) != joint.nq)
+      fail(src, d.element, std::string("'position' needs ") + std::to_string(joint.nq) +
+                               " numbers for a " + toString(joint.type) + " joint, got " +
+                               std::to_string(d.position->size()));
+    for (int k = 0; k < joint.nq; ++k) qs(k) = (*d.position)[k];
+  }
+  const bool floating = joint.type == JointType::Floating, ball = joint.type == JointType::Ball;
+  if (d.xyz) {
+    if (!floating) fail(src, d.element, "'xyz' applies to a floating joint only");
+    qs.head<3>() = *d.xyz;
+  }
+  if (d.rpy || d.quat) {
+    if (!floating && !ball) fail(src, d.element, "'rpy'/'quat' apply to floating and ball joints only");
+    Quat qu;
+    if (d.rpy) {
+      qu = Quat(rpyToMatrix(*d.rpy));
+    } else {
+      const auto& c = *d.quat;
+      qu = Quat(c[3], c[0], c[1], c[2]);
+    }
+    qs.tail<4>() << qu.x(), qu.y(), qu.z(), qu.w();
+  }
+  if (floating || ball) {
+    auto quat = qs.tail<4>();
+    if (quat.norm() < 1e-9) fail(src, d.element, "the orientation quaternion is zero");
+    quat.normalize();
+  }
+  if (d.velocity) {
+    if (static_cast<int>(d.velocity->size()) != joint.nv)
+      fail(src, d.element, std::string("'velocity' needs ") + std::to_string(joint.nv) +
+                               " numbers for a " + toString(joint.type) + " joint, got " +
+                               std::to_string(d.velocity->size()));
+    for (int k = 0; k < joint.nv; ++k) v(joint.idx_v + k) = (*d.velocity)[k];
+  }
+}
+
+}  // namespace
+
+void buildSceneContents(const XmlSource& src, const AppellBlock& block, Scene& scene) {
+  const Model& model = scene.model;
+  for (const SupportDecl& d : block.supports) {
+    Support support = d.support;
+    try {
+      // Checks the triangles (degenerate ones name their index) and builds the index.
+      if (d.terrain)
+        support.surface = makeTerrain(d.terrain_mesh->vertices, d.terrain_mesh->triangles);
+      validateSupport(support);
+    } catch (const std::invalid_argument& e) {
+      fail(src, d.element,
+           d.terrain ? std::string(e.what()) + " (in " + d.terrain_path + ")" : e.what());
+    }
+    scene.supports.push_back(std::move(support));
+  }
+  for (const ContactDecl& c : block.contacts) {
+    ContactInfo info;
+    info.name = c.name;
+    info.link = c.link;
+    info.body = model.bodyIndex(c.link);
+    if (info.body < 0) fail(src, c.element, "unknown link '" + c.link + "'");
+    info.kind = c.kind;
+    info.support = c.support;
+    for (int k = 0; k < static_cast<int>(scene.supports.size()); ++k)
+      if (scene.supports[k].name == c.support) info.support_index = k;
+    info.shape = contactShape(src, c, scene.geometry[info.body], info.shape_source);
+    info.blade_direction = c.blade_direction;
+    info.mu = c.mu;
+    info.line = c.element->Row();
+    ContactOptions options;
+    options.name = c.name;
+    options.blade_direction = c.blade_direction;
+    try {
+      scene.constraints.push_back(makeContact(info.kind, info.body, info.shape,
+                                              scene.supports[info.support_index], options));
+    } catch (const std::invalid_argument& e) {
+      fail(src, c.element, std::string(e.what()) + " (shape: " + shapeName(info.shape) + " from " +
+                               info.shape_source + ")");
+    }
+    scene.contacts.push_back(std::move(info));
+  }
+  scene.q0 = neutralConfiguration(model);
+  scene.v0 = VecX::Zero(model.nv);
+  for (const JointStateDecl& d : block.initial) setJointState(src, model, d, scene.q0, scene.v0);
+  scene.tau = VecX::Zero(model.nv);
+  for (const EffortDecl& e : block.efforts) {
+    const int j = model.jointIndex(e.joint);
+    if (j < 0) fail(src, e.element, "unknown joint '" + e.joint + "'");
+    const Joint& joint = model.joints[j];
+    if (static_cast<int>(e.value.size()) != joint.nv)
+      fail(src, e.element, std::string("'value' needs ") + std::to_string(joint.nv) +
+                               " numbers for a " + toString(joint.type) + " joint, got " +
+                               std::to_string(e.value.size()));
+    for (int k = 0; k < joint.nv; ++k) scene.tau(joint.idx_v + k) += e.value[k];
+  }
+  scene.settings = block.settings;
+}
+
+}  // namespace appell::io

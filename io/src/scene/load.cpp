@@ -1,0 +1,32 @@
+// The loader's entry points: read, check, build — all or nothing.
+#include "scene/block.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace appell {
+
+Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
+                          const std::string& name, const LoadOptions& options) {
+  const io::XmlSource src{name};
+  TiXmlDocument doc;
+  const TiXmlElement* robot = io::parseDocument(src, doc, xml);
+  const io::UrdfIndex index = io::checkUrdf(src, robot);
+  const io::AppellBlock block = io::parseAppellBlock(src, robot, base_dir, options);
+  io::Robot parsed = io::buildRobot(src, index, xml, base_dir, options, block.gravity);
+  Scene scene;
+  scene.model = std::move(parsed.model);
+  scene.geometry = std::move(parsed.geometry);
+  scene.source = name;
+  io::buildSceneContents(src, block, scene);
+  if (options.check_initial_state)
+    checkInitialState(scene, options.project_initial_state, options.initial_state_tolerance);
+  return scene;
+}
+
+Scene loadScene(const std::string& path, const LoadOptions& options) {
+  return loadSceneFromString(io::readFile(path), io::folderOf(path), path, options);
+}
+
+}  // namespace appell

@@ -1,0 +1,118 @@
+#include "urdf/xml_util.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace appell::io {
+
+std::string describe(const TiXmlElement* e) {
+  std::string s = "<" + std::string(e->Value());
+  if (const char* n = e->Attribute("name")) s += " name=\"" + std::string(n) + "\"";
+  else if (const char* l = e->Attribute("link")) s += " link=\"" + std::string(l) + "\"";
+  return s + ">";
+}
+
+void fail(const XmlSource& src, const TiXmlElement* e, const std::string& reason) {
+  std::string where = src.file;
+  if (e && e->Row() > 0) where += ":" + std::to_string(e->Row());
+  throw SceneError(where + ": " + (e ? describe(e) + ": " : std::string()) + reason);
+}
+
+void fail(const XmlSource& src, const std::string& reason) {
+  throw SceneError(src.file + ": " + reason);
+}
+
+std::optional<double> parseNumber(const std::string& str, bool* finite) {
+  std::size_t b = str.find_first_not_of(" \t\r\n");
+  std::size_t e = str.find_last_not_of(" \t\r\n");
+  if (b == std::string::npos) return std::nullopt;
+  const char* first = str.data() + b;
+  const char* last = str.data() + e + 1;
+  if (*first == '+') ++first;  // from_chars does not take a leading '+'
+  double x = 0;
+  const auto r = std::from_chars(first, last, x);
+  if (r.ec != std::errc() || r.ptr != last) return std::nullopt;
+  if (finite) *finite = std::isfinite(x);
+  return x;
+}
+
+bool has(const TiXmlElement* e, const char* attr) { return e->Attribute(attr) != nullptr; }
+
+std::string text(const XmlSource& src, const TiXmlElement* e, const char* attr) {
+  const char* a = e->Attribute(attr);
+  if (!a) fail(src, e, std::string("missing attribute '") + attr + "'");
+  return a;
+}
+
+std::string text(const TiXmlElement* e, const char* attr, const std::string& fallback) {
+  const char* a = e->Attribute(attr);
+  return a ? std::string(a) : fallback;
+}
+
+std::vector<double> numbers(const XmlSource& src, const TiXmlElement* e, const char* attr,
+                            int count) {
+  const std::string s = text(src, e, attr);
+  std::istringstream in(s);
+  std::vector<double> out;
+  std::string word;
+  while (in >> word) {
+    bool finite = true;
+    const auto x = parseNumber(word, &finite);
+    if (!x)
+      fail(src, e, std::string("attribute '") + attr + "': \"" + word + "\" is not a number");
+    if (!finite)
+      fail(src, e, std::string("attribute '") + attr + "': \"" + word + "\" is not finite");
+    out.push_back(*x);
+  }
+  if (count >= 0 && static_cast<int>(out.size()) != count)
+    fail(src, e, std::string("attribute '") + attr + "' needs " + std::to_string(count) +
+                     " numbers, got " + std::to_string(out.size()) + " (\"" + s + "\")");
+  if (count < 0 && out.empty()) fail(src, e, std::string("attribute '") + attr + "' is empty");
+  return out;
+}
+
+double number(const XmlSource& src, const TiXmlElement* e, const char* attr) {
+  return numbers(src, e, attr, 1)[0];
+}
+
+double number(const XmlSource& src, const TiXmlElement* e, const char* attr, double fallback) {
+  return has(e, attr) ? number(src, e, attr) : fallback;
+}
+
+Vec3 vec3(const XmlSource& src, const TiXmlElement* e, const char* attr) {
+  const auto v = numbers(src, e, attr, 3);
+  return {v[0], v[1], v[2]};
+}
+
+Vec3 vec3(const XmlSource& src, const TiXmlElement* e, const char* attr, const Vec3& fallback) {
+  return has(e, attr) ? vec3(src, e, attr) : fallback;
+}
+
+void allowOnly(const XmlSource& src, const TiXmlElement* e, std::initializer_list<const char*> allowed) {
+  for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+    bool ok = false;
+    for (const char* name : allowed) ok = ok || std::string(a->Name()) == name;
+    if (ok) continue;
+    std::string list;
+    for (const char* name : allowed) list += (list.empty() ? "" : ", ") + std::string(name);
+    fail(src, e, "unknown attribute '" + std::string(a->Name()) + "' (allowed here: " +
+                     (list.empty() ? std::string("none") : list) + ")");
+  }
+}
+
+Mat3 rpyToMatrix(const Vec3& rpy) {
+  return axisAngle(Vec3::UnitZ(), rpy.z()) * axisAngle(Vec3::UnitY(), rpy.y()) *
+         axisAngle(Vec3::UnitX(), rpy.x());
+}
+
+SE3 origin(const XmlSource& src, const TiXmlElement* e) {
+  SE3 X;
+  if (const TiXmlElement* o = e->FirstChildElement("origin")) {
+    X.p = vec3(src, o, "xyz", Vec3::Zero());
+    X.R = rpyToMatrix(vec3(src, o, "rpy", Vec3::Zero()));
+  }
+  return X;
+}
+
+}  // namespace appell::io
