@@ -1,9 +1,13 @@
 // Spatial algebra — the one convention used everywhere in appell.
 //
-// Featherstone (2008), ch. 2, with Pinocchio's naming:
+// Featherstone, Rigid Body Dynamics Algorithms (2008), ch. 2, angular part first:
 //   motion vector  m = [ω; v]  (angular velocity; velocity of the point at the
 //                               frame origin), both expressed in that frame;
 //   force vector   f = [n; f]  (moment about the frame origin; force).
+// This is Featherstone's order and the REVERSE of Pinocchio's, which stores
+// [v; ω] and [f; n]: when porting a formula or comparing numbers with
+// Pinocchio, swap the two 3-blocks (and the blocks of 6 × 6 matrices).
+// Method names (act, actInv, cross) follow Pinocchio's.
 //   SE3 {R, p} is the pose of frame B in frame A:  x_A = R x_B + p.
 //   act()    maps a vector expressed in B into A;  actInv() maps A into B.
 // Spatial inertia is about the frame origin:  I = [[Ī + m[c][c]ᵀ, m[c]], [m[c]ᵀ, m·1]].
