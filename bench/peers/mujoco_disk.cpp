@@ -8,7 +8,9 @@
 // cylinder of half-height h with the thin disk's inertia given explicitly, on a
 // plane, with solref time constant 2·dt (the stiffest MuJoCo's documentation
 // recommends), friction 1 and an elliptic cone, stepped by MuJoCo's default
-// semi-implicit Euler.
+// semi-implicit Euler; optionally with MuJoCo's "noslip" post-processing
+// (noslip_iterations > 0: a projected Gauss–Seidel pass on the friction
+// forces without regularisation, which its documentation offers against creep).
 #include "peer_engines.hpp"
 
 #include <mujoco/mujoco.h>
@@ -22,12 +24,12 @@
 namespace peers {
 namespace {
 
-std::string modelXml(const DiskProblem& p, double dt) {
+std::string modelXml(const DiskProblem& p, double dt, int noslip) {
   std::ostringstream x;
   x.precision(17);
   x << "<mujoco model='rolling_cylinder'>\n"
     << "  <option timestep='" << dt << "' gravity='0 0 " << -p.gravity
-    << "' integrator='Euler' cone='elliptic'/>\n"
+    << "' integrator='Euler' cone='elliptic' noslip_iterations='" << noslip << "'/>\n"
     << "  <worldbody>\n"
     << "    <geom name='floor' type='plane' size='0 0 1' friction='1 0.005 0.0001' solref='" << 2 * dt
     << " 1'/>\n"
@@ -47,9 +49,9 @@ struct MujocoDisk {
   mjModel* m = nullptr;
   mjData* d = nullptr;
 
-  MujocoDisk(const DiskProblem& p, double dt) {
+  MujocoDisk(const DiskProblem& p, double dt, int noslip) {
     if (!(p.half_thickness > 0)) throw std::invalid_argument("mujoco: needs a cylinder of positive thickness");
-    const std::string xml = modelXml(p, dt);
+    const std::string xml = modelXml(p, dt, noslip);
     auto vfs = std::make_unique<mjVFS>();  // ≈ 2 MB: not on the stack
     mj_defaultVFS(vfs.get());
     const char* name = "rolling_cylinder.xml";
@@ -95,11 +97,11 @@ struct MujocoDisk {
 
 }  // namespace
 
-PeerRun runMujoco(const DiskProblem& p, double dt, bool diagnostics) {
-  MujocoDisk md(p, dt);
+PeerRun runMujoco(const DiskProblem& p, double dt, int noslip, bool diagnostics) {
+  MujocoDisk md(p, dt, noslip);
   PeerRun r;
   r.engine = "mujoco";
-  r.method = "euler";
+  r.method = noslip > 0 ? "euler-noslip" : "euler";
   r.setting = dt;
   const long n1 = std::lround(1.0 / dt), n10 = std::lround(p.duration / dt);
   double slip_sum = 0;
@@ -131,7 +133,7 @@ PeerRun runMujoco(const DiskProblem& p, double dt, bool diagnostics) {
 }
 
 double mujocoForwardSeconds(const DiskProblem& p, double dt, int n) {
-  MujocoDisk md(p, dt);
+  MujocoDisk md(p, dt, 0);
   std::vector<double> batches;
   const int per = 2000;
   for (int k = 0; k < n; ++k) {

@@ -25,7 +25,7 @@ double simbodyEvaluationSeconds(const DiskProblem& p, int n);
 /// 2·dt, MuJoCo's stiffest recommended), semi-implicit Euler at step `dt`.
 /// With `diagnostics`, also the slip speed and penetration over the run
 /// (not for timing: they are computed every step).
-PeerRun runMujoco(const DiskProblem& p, double dt, bool diagnostics);
+PeerRun runMujoco(const DiskProblem& p, double dt, int noslip, bool diagnostics);
 /// CPU seconds of one mj_forward at the initial state, median of `n` batches.
 double mujocoForwardSeconds(const DiskProblem& p, double dt, int n);
 #endif

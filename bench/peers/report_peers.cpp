@@ -242,6 +242,9 @@ Case makeCase(const std::string& name) {
   return c;
 }
 
+/// MuJoCo's noslip iterations for a row's method name.
+[[maybe_unused]] int mujocoNoslip(const std::string& method) { return method == "euler-noslip" ? 10 : 0; }
+
 struct Row {
   std::string case_name, engine, method;
   double setting = 0;
@@ -345,6 +348,7 @@ int main(int argc, char** argv) {
 #endif
 #ifdef PEERS_HAVE_MUJOCO
     for (double dt : {2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4}) add("mujoco", "euler", dt, true);
+    for (double dt : {1e-3, 2.5e-4}) add("mujoco", "euler-noslip", dt, true);
 #endif
   }
   std::map<std::string, const Case*> by_name;
@@ -364,7 +368,7 @@ int main(int argc, char** argv) {
       if (r.engine == "simbody") run = runSimbody(c.thin, r.method, r.setting);
 #endif
 #ifdef PEERS_HAVE_MUJOCO
-      if (r.engine == "mujoco") run = runMujoco(c.cyl, r.setting, false);
+      if (r.engine == "mujoco") run = runMujoco(c.cyl, r.setting, mujocoNoslip(r.method), false);
 #endif
       r.cpu.push_back(run.cpu);
       r.last = run;
@@ -391,7 +395,7 @@ int main(int argc, char** argv) {
     }
 #ifdef PEERS_HAVE_MUJOCO
     if (r.engine == "mujoco") {
-      const PeerRun d = runMujoco(p, r.setting, true);
+      const PeerRun d = runMujoco(p, r.setting, mujocoNoslip(r.method), true);
       r.last.max_slip = d.max_slip;
       r.last.mean_slip = d.mean_slip;
       r.last.max_penetration = d.max_penetration;
@@ -479,7 +483,7 @@ int main(int argc, char** argv) {
     for (const Row* m : mujoco) {
       if (m->setting != 1e-3) continue;
       const double ea = errorAtCost(ap, m->perSimSecond());
-      md << "| " << c.name << " | error at 10 s at MuJoCo's cost (dt 1e-3, " << fixed(1e3 * m->perSimSecond(), 3)
+      md << "| " << c.name << " | error at 10 s at MuJoCo's cost (" << m->method << ", dt 1e-3, " << fixed(1e3 * m->perSimSecond(), 3)
          << " ms per simulated s) | MuJoCo " << sci(m->err10) << " m | " << sci(ea) << " m | "
          << sci(m->err10 / ea, 1) << "× smaller error |\n";
     }
@@ -506,7 +510,7 @@ int main(int argc, char** argv) {
        << "set logscale xy\nset format y '1e%L'\nset format x '1e%L'\nset grid\n"
        << "set xlabel 'CPU time per simulated second [s]'\nset ylabel 'centre position error at t = 10 s [m]'\n"
        << "set key bottom left\n"
-       << "methods = 'appell/dopri5 appell/rk4 appell/dopri5-cylinder simbody/merson simbody/rk3 mujoco/euler'\n"
+       << "methods = 'appell/dopri5 appell/rk4 appell/dopri5-cylinder simbody/merson simbody/rk3 mujoco/euler mujoco/euler-noslip'\n"
        << "eng(i) = substr(word(methods,i), 1, strstrt(word(methods,i),'/')-1)\n"
        << "met(i) = substr(word(methods,i), strstrt(word(methods,i),'/')+1, strlen(word(methods,i)))\n"
        << "set multiplot layout 1,2\n";
