@@ -10,8 +10,9 @@
 // Steady motion. With lean-frame rates u₁ = θ̇, u₂ = ω·a (about the axle),
 // u₃ = ω·u (about the in-plane "up" direction u = (c − P)/R), the thin disk obeys
 //   u̇₁ = (6 u₂ u₃ R − u₃² R tan θ + 4 g sin θ)/(5R)
-// (Kane's equations of the rolling disk; e.g. Neimark & Fufaev, Dynamics of
-// Nonholonomic Systems, ch. II). A turn at rate Ω about the vertical has
+// (Kane's equations of the rolling disc: Kane & Levinson, Dynamics: Theory and
+// Applications, 1985; reproduced by SymPy's sympy.physics.mechanics rolling-disc
+// test). A turn at rate Ω about the vertical has
 // u₃ = Ω cos θ; rolling gives the centre the velocity v_c = ω × (c − P) = −R u₂ t
 // (t the travel direction), and a uniform turn about a vertical axis at
 // distance ρ from the centre needs |v_c| = Ω ρ, so u₂ = −Ω ρ/R with the axis on
@@ -21,7 +22,7 @@
 //   c(t) = O + Rz(Ω t)(c₀ − O),  O = c₀ + (e_z × v_c₀)/Ω.
 // The program checks this Ω, u₂ against the scene library's independent
 // angular-momentum balance (steadyDiskAxleRate, examples/scenes/rolling_disk.hpp).
-// The spin case has no closed form: its reference is appell's dormand–prince at
+// The spin case has no closed form: its reference is appell's Dormand–Prince at
 // tol 1e-14 with the dense multiplier (KKT) formulation — a different solver
 // from the tree solver the measured appell runs use — and the report states how
 // far the next-tightest run and Simbody's tightest run are from it.
