@@ -1,6 +1,7 @@
 // appell run: simulate a scene, summarise it, write its trajectory.
 #include "commands.hpp"
 #include "contact_report.hpp"
+#include "plot.hpp"
 
 #include <appell/appell.hpp>
 #include <appell/output.hpp>
@@ -28,6 +29,8 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
   --formulation F     tree | kkt | appell   (default: the scene's, else tree)
   --out FILE.csv      write the trajectory (every step, or every --every N)
   --every N           write every N-th step to the CSV (default 1)
+  --plot              plot the trajectory at the end (as `appell plot`, into
+                      the folder FILE_plots beside --out FILE.csv)
   --no-projection     do not project onto the constraints after each step
   --package-path DIRS colon/comma-separated folders for package:// meshes
   --project-initial   project an initial state that violates the constraints
@@ -71,7 +74,7 @@ class Progress {
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path"},
-            {"project-initial", "help", "no-projection", "quiet"});
+            {"project-initial", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -85,6 +88,7 @@ int run(int argc, char** argv) {
   s.integrator = args.text("integrator", s.integrator);
   s.formulation = args.text("formulation", s.formulation);
   const int every = args.integer("every", 1);
+  if (args.has("plot") && !args.has("out")) throw UsageError("--plot plots the trajectory: give --out FILE.csv");
   if (every < 1) throw UsageError("option --every must be at least 1");
   IntegratorType itype;
   Formulation form;
@@ -193,6 +197,11 @@ int run(int argc, char** argv) {
   contacts.print(std::cout);
   if (writer) std::cout << "trajectory   " << args.text("out") << " (" << writer->samples() << " rows, "
                         << writer->columns().size() << " columns)\n";
+  if (args.has("plot")) {
+    csv.close();
+    for (const std::string& png : writePlots(args.text("out"), defaultPlotDir(args.text("out")), &scene))
+      std::cout << "plot         " << png << "\n";
+  }
   return status.ok ? 0 : 3;
 }
 

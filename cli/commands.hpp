@@ -11,6 +11,8 @@ int run(int argc, char** argv);
 int info(int argc, char** argv);
 int equilibria(int argc, char** argv);
 int linearize(int argc, char** argv);
+int view(int argc, char** argv);
+int plot(int argc, char** argv);
 
 /// Options every command that loads a scene accepts.
 inline const std::set<std::string> kLoadOptions = {"package-path"};

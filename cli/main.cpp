@@ -7,12 +7,15 @@
 namespace {
 
 const char* kUsage = R"(usage: appell <command> SCENE.urdf [options]
+       appell plot RUN.csv [options]
 
 commands:
   run          simulate the scene, print a summary, write the trajectory (CSV)
   info         bodies, joints, degrees of freedom, contacts, constraint rows
   equilibria   find equilibria (including those held by nonholonomic reactions)
   linearize    eigenvalues of the linearized constrained dynamics
+  view         a self-contained HTML page replaying a run in 3-D (three.js)
+  plot         PNG plots of a run's CSV: energy, residuals, contact loads, path
 
 'appell <command> --help' describes each command's options.
 )";
@@ -31,6 +34,8 @@ int main(int argc, char** argv) {
     if (cmd == "info") return info(argc, argv);
     if (cmd == "equilibria") return equilibria(argc, argv);
     if (cmd == "linearize") return linearize(argc, argv);
+    if (cmd == "view") return view(argc, argv);
+    if (cmd == "plot") return plot(argc, argv);
     std::cerr << "appell: unknown command '" << cmd << "'\n" << kUsage;
     return 2;
   } catch (const UsageError& e) {

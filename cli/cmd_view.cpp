@@ -1,0 +1,311 @@
+// appell view: a self-contained HTML page that replays a run in 3-D.
+//
+// The page draws what appell computed, not a re-derivation of it: for every
+// CSV sample the command runs forward kinematics on the sample's q (body poses
+// oMi) and evaluates each constraint at (q, v, t) for its rows; the reaction
+// force on the contact body is f = Σ_r λ_r d_r, with λ_r from the CSV and d_r
+// the linear part of row r's world covector W_r = [p × d_r; d_r] (the row
+// constrains d_r · v_p, so λ_r is the force along d_r — constraint.hpp).
+// Without a trajectory the page shows the initial state, with λ from the
+// dynamics solved there.
+#include "commands.hpp"
+
+#include <appell/appell.hpp>
+#include <appell/output.hpp>
+#include <appell/simulator.hpp>
+#include <appell/trajectory_reader.hpp>
+#include <appell_viewer/assets.hpp>
+
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace appell::cli {
+
+namespace {
+
+const char* kHelp = R"(usage: appell view SCENE.urdf [options]
+
+Writes one HTML file that replays the motion in 3-D (three.js, embedded: the
+page loads nothing). Open it in a browser: play/pause, scrub, orbit with the mouse.
+
+  --trajectory RUN.csv  the motion, as `appell run --out` wrote it
+                        (default: the initial state only)
+  --out PAGE.html       where to write the page (default: SCENE name + .html)
+  --package-path DIRS   colon/comma-separated folders for package:// meshes
+  --project-initial     project an initial state that violates the constraints
+
+Page URL options (after #): t=2.5 (show that time), view=top (orthographic from
+above), center=x,y and span=S (top view framing, metres), play=1.
+)";
+
+/// The page's data as JSON, written by hand: numbers in the shortest form that
+/// reads back to the same double, so the page shows the CSV's values.
+class Json {
+ public:
+  Json& num(double x) {
+    sep();
+    if (!std::isfinite(x)) {
+      s_ += "null";
+      return *this;
+    }
+    char buf[32];
+    s_.append(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
+    return *this;
+  }
+  Json& str(const std::string& t) {
+    sep();
+    s_ += '"';
+    for (const char c : t) {
+      if (c == '"' || c == '\\') s_ += '\\', s_ += c;
+      else if (c == '<') s_ += "\\u003c";  // never "</script>" inside the page's <script>
+      else if (static_cast<unsigned char>(c) < 0x20) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "\\u%04x", c);
+        s_ += buf;
+      } else s_ += c;
+    }
+    s_ += '"';
+    return *this;
+  }
+  Json& key(const std::string& k) {
+    str(k);
+    s_ += ':';
+    first_ = true;
+    return *this;
+  }
+  Json& open(char c) {
+    sep();
+    s_ += c;
+    first_ = true;
+    return *this;
+  }
+  Json& close(char c) {
+    s_ += c;
+    first_ = false;
+    return *this;
+  }
+  Json& raw(const char* t) {
+    sep();
+    s_ += t;
+    return *this;
+  }
+  template <class V>
+  Json& vec(const V& v) {
+    open('[');
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(v.size()); ++i) num(v[i]);
+    return close(']');
+  }
+  const std::string& text() const { return s_; }
+
+ private:
+  void sep() {
+    if (!first_) s_ += ',';
+    first_ = false;
+  }
+  std::string s_;
+  bool first_ = true;
+};
+
+void writeGeometry(Json& j, const Geometry& g) {
+  j.open('{').key("type");
+  const Quat q(g.origin.R);
+  switch (g.type) {
+    case GeometryType::Box: j.str("box").key("size").vec(g.box_size); break;
+    case GeometryType::Sphere: j.str("sphere").key("radius").num(g.radius); break;
+    case GeometryType::Cylinder:
+      j.str("cylinder").key("radius").num(g.radius).key("length").num(g.length);
+      break;
+    case GeometryType::Mesh: {
+      j.str("mesh").key("vertices").open('[');
+      for (const Vec3& v : g.mesh->vertices) j.num(v.x()).num(v.y()).num(v.z());
+      j.close(']').key("triangles").open('[');
+      for (const auto& t : g.mesh->triangles) j.num(t[0]).num(t[1]).num(t[2]);
+      j.close(']');
+      break;
+    }
+  }
+  j.key("p").vec(g.origin.p).key("q").open('[').num(q.x()).num(q.y()).num(q.z()).num(q.w());
+  j.close(']').close('}');
+}
+
+/// Radius of a ball about the body origin holding the geometry (frames the camera).
+double reach(const Geometry& g) {
+  double r = 0;
+  switch (g.type) {
+    case GeometryType::Box: r = 0.5 * g.box_size.norm(); break;
+    case GeometryType::Sphere: r = g.radius; break;
+    case GeometryType::Cylinder: r = std::hypot(g.radius, 0.5 * g.length); break;
+    case GeometryType::Mesh:
+      for (const Vec3& v : g.mesh->vertices) r = std::max(r, v.norm());
+      break;
+  }
+  return r + g.origin.p.norm();
+}
+
+/// One sample of what the page shows.
+struct Frame {
+  double t;
+  std::vector<double> poses, points, forces;  // 7 per body, 3 per constraint, 3 per constraint
+};
+
+Frame frameAt(const Scene& scene, Data& data, std::vector<RowBlock>& blocks, double t,
+              const VecX& q, const VecX& v, const VecX& lambda) {
+  const Model& m = scene.model;
+  Frame f{t, {}, {}, {}};
+  forwardKinematics(m, data, q, v);
+  for (int b = 0; b < m.nbodies; ++b) {
+    const SE3& X = data.oMi[b];
+    const Quat r(X.R);
+    f.poses.insert(f.poses.end(), {X.p.x(), X.p.y(), X.p.z(), r.x(), r.y(), r.z(), r.w()});
+  }
+  int row = 0;
+  for (size_t c = 0; c < scene.constraints.size(); ++c) {
+    const Constraint& con = *scene.constraints[c];
+    con.evaluate(m, data, t, q, v, blocks[c]);
+    Vec3 force = Vec3::Zero();
+    if (!con.jointSpace())
+      for (int r = 0; r < con.rows(); ++r) force += lambda[row + r] * blocks[c].Wa.row(r).tail<3>().transpose();
+    row += con.rows();
+    const Vec3& p = blocks[c].frame.point;
+    f.points.insert(f.points.end(), {p.x(), p.y(), p.z()});
+    f.forces.insert(f.forces.end(), {force.x(), force.y(), force.z()});
+  }
+  return f;
+}
+
+std::vector<Frame> framesFromTrajectory(const Scene& scene, const std::string& path) {
+  const TrajectoryTable table = readTrajectory(path);
+  const Model& m = scene.model;
+  const std::vector<std::string> names = trajectoryColumns(m, scene.constraints);
+  // Columns in the writer's order: time, q (nq), v (nv), energy, residual, then per constraint.
+  std::vector<int> qcol, vcol, lcol;
+  for (int i = 0; i < m.nq; ++i) qcol.push_back(table.require(names[1 + i]));
+  for (int i = 0; i < m.nv; ++i) vcol.push_back(table.require(names[1 + m.nq + i]));
+  for (const std::string& n : names)
+    if (n.rfind("lambda:", 0) == 0) lcol.push_back(table.require(n));
+  Data data(m);
+  std::vector<RowBlock> blocks(scene.constraints.size());
+  for (size_t c = 0; c < blocks.size(); ++c) scene.constraints[c]->reserve(m, blocks[c]);
+  VecX q(m.nq), v(m.nv), lambda(lcol.size());
+  std::vector<Frame> frames;
+  for (const auto& row : table.rows) {
+    for (int i = 0; i < m.nq; ++i) q[i] = row[qcol[i]];
+    for (int i = 0; i < m.nv; ++i) v[i] = row[vcol[i]];
+    for (size_t i = 0; i < lcol.size(); ++i) lambda[i] = row[lcol[i]];
+    frames.push_back(frameAt(scene, data, blocks, row[0], q, v, lambda));
+  }
+  return frames;
+}
+
+std::vector<Frame> initialFrame(const Scene& scene) {
+  Simulator sim(scene.model, scene.constraints,
+                makeSolver(formulationFromString(scene.settings.formulation), scene.model,
+                           scene.constraints),
+                IntegratorType::RK4);
+  if (scene.tau.size() == scene.model.nv) {
+    const VecX tau = scene.tau;
+    sim.setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
+  }
+  sim.setState(0.0, scene.q0, scene.v0);
+  Data data(scene.model);
+  std::vector<RowBlock> blocks(scene.constraints.size());
+  for (size_t c = 0; c < blocks.size(); ++c) scene.constraints[c]->reserve(scene.model, blocks[c]);
+  return {frameAt(scene, data, blocks, 0.0, scene.q0, scene.v0, sim.lambda())};
+}
+
+/// Height of the first world-fixed horizontal plane (the grid goes there), NaN if none.
+double groundHeight(const Scene& scene) {
+  for (const Support& s : scene.supports) {
+    const Plane* plane = std::get_if<Plane>(&s.surface);
+    if (!plane || s.body >= 0 || isMoving(s.motion)) continue;
+    const SE3 X = supportState(s.motion, 0.0).pose;
+    if ((X.R * plane->normal).z() > 1 - 1e-12) return X.apply(plane->point).z();
+  }
+  return std::nan("");
+}
+
+std::string pageJson(const Scene& scene, const std::vector<Frame>& frames) {
+  Json j;
+  j.open('{').key("title").str(std::filesystem::path(scene.source).filename().string());
+  double size = 0;
+  j.key("bodies").open('[');
+  for (int b = 0; b < scene.model.nbodies; ++b) {
+    bool moves = false;
+    for (const Frame& f : frames)
+      for (int k = 0; k < 3; ++k) moves |= f.poses[7 * b + k] != frames[0].poses[7 * b + k];
+    j.open('{').key("name").str(scene.model.body_names[b]).key("moves").raw(moves ? "true" : "false");
+    j.key("geometry").open('[');
+    if (b < static_cast<int>(scene.geometry.size()))
+      for (const Geometry& g : scene.geometry[b].visual) {
+        if (g.type == GeometryType::Mesh && !g.mesh) continue;
+        writeGeometry(j, g);
+        size = std::max(size, reach(g));
+      }
+    j.close(']').close('}');
+  }
+  j.close(']').key("contacts").open('[');
+  for (const auto& c : scene.constraints) j.open('{').key("name").str(c->name()).close('}');
+  j.close(']').key("size").num(std::max(size, 1e-3)).key("ground").num(groundHeight(scene));
+  j.key("times").open('[');
+  for (const Frame& f : frames) j.num(f.t);
+  j.close(']');
+  for (const char* name : {"poses", "points", "forces"}) {
+    j.key(name).open('[');
+    for (const Frame& f : frames) {
+      const std::string n = name;
+      j.vec(n == "poses" ? f.poses : n == "points" ? f.points : f.forces);
+    }
+    j.close(']');
+  }
+  return j.close('}').text();
+}
+
+std::string fill(std::string_view page, const std::string& title, const std::string& data,
+                 std::string_view script) {
+  std::string out;
+  size_t at = 0;
+  while (true) {
+    const size_t k = page.find('@', at);
+    if (k == std::string_view::npos) break;
+    out.append(page.substr(at, k - at));
+    if (page.substr(k, 7) == "@TITLE@") out += title, at = k + 7;
+    else if (page.substr(k, 6) == "@DATA@") out += data, at = k + 6;
+    else if (page.substr(k, 8) == "@SCRIPT@") out.append(script), at = k + 8;
+    else out += '@', at = k + 1;
+  }
+  out.append(page.substr(at));
+  return out;
+}
+
+}  // namespace
+
+int view(int argc, char** argv) {
+  std::set<std::string> valued = kLoadOptions;
+  valued.insert({"trajectory", "out"});
+  Args args(argc, argv, 2, valued, kLoadFlags);
+  if (args.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  if (viewer::script().empty())
+    throw std::runtime_error(
+        "this appell was built without the viewer's three.js (viewer/node_modules is missing): "
+        "run scripts/install-viewer-deps.sh, then rebuild");
+  const Scene scene = loadFromArgs(args, !args.has("trajectory"));
+  const std::vector<Frame> frames =
+      args.has("trajectory") ? framesFromTrajectory(scene, args.text("trajectory")) : initialFrame(scene);
+  const std::string stem = std::filesystem::path(scene.source).stem().string();
+  const std::string out = args.text("out", stem + ".html");
+  std::ofstream page(out, std::ios::binary);
+  if (!page) throw std::runtime_error("cannot write '" + out + "'");
+  page << fill(viewer::pageTemplate(), stem, pageJson(scene, frames), viewer::script());
+  if (!page.flush()) throw std::runtime_error("error writing '" + out + "'");
+  std::cout << "page         " << out << " (" << frames.size() << " samples, t = " << frames.front().t
+            << " … " << frames.back().t << " s)\n";
+  return 0;
+}
+
+}  // namespace appell::cli

@@ -1,0 +1,29 @@
+// Trajectories in: a CSV that TrajectoryWriter (output.hpp) wrote, read back
+// as named columns of doubles, so `appell view` and `appell plot` see exactly
+// the numbers the run wrote (they are written in the shortest form that reads
+// back to the same double, and read here with std::from_chars).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace appell {
+
+struct TrajectoryTable {
+  std::string source;                       ///< the file, for messages
+  std::vector<std::string> columns;         ///< header names (output.hpp lists them)
+  std::vector<std::vector<double>> rows;    ///< one per sample, columns.size() numbers each
+
+  /// Index of the named column, −1 if absent.
+  int find(const std::string& name) const;
+  /// Index of the named column; throws std::runtime_error naming file and column if absent.
+  int require(const std::string& name) const;
+  /// One column over all samples.
+  std::vector<double> column(int index) const;
+};
+
+/// Reads a trajectory CSV (RFC 4180 quoting in the header). Throws
+/// std::runtime_error naming file, line and reason on a malformed file.
+TrajectoryTable readTrajectory(const std::string& path);
+
+}  // namespace appell

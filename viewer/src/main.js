@@ -1,0 +1,231 @@
+// The replay page of `appell view`: draws the scene's visual geometry at the
+// body poses the CLI computed (forward kinematics of each CSV sample, so
+// nothing is re-derived here), the contact points, the reaction forces
+// f = Σ_r λ_r d_r as arrows (d_r the row directions), the paths traced by the
+// bodies and the contacts, and a ground grid. Between samples, positions are
+// interpolated linearly and orientations by slerp.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+
+const data = JSON.parse(document.getElementById('appell-data').textContent);
+const nb = data.bodies.length, nc = data.contacts.length, ns = data.times.length;
+const t0 = data.times[0], t1 = data.times[ns - 1];
+
+// ---- options from the URL hash: #t=2.5&view=top&center=x,y&span=S&play=1&contacts=0
+const opts = Object.fromEntries(new URLSearchParams(location.hash.slice(1)));
+
+// ---- renderer, scene, lights (z is up, as in appell)
+const host = document.getElementById('scene');
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+renderer.setSize(host.clientWidth, host.clientHeight);
+host.appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xf4f4f2);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x808080, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(0.3, -0.5, 1);
+scene.add(sun);
+
+// ---- extent of the motion: frames the camera, sizes the grid and the arrows
+const box = new THREE.Box3();
+for (let s = 0; s < ns; ++s)
+  for (let b = 0; b < nb; ++b) {
+    const o = data.poses[s], k = 7 * b;
+    box.expandByPoint(new THREE.Vector3(o[k], o[k + 1], o[k + 2]));
+  }
+box.expandByScalar(data.size);
+const centre = box.getCenter(new THREE.Vector3());
+const extent = Math.max(box.getSize(new THREE.Vector3()).length(), 1e-3);
+
+// ---- ground grid: in the scene's horizontal ground plane, else under everything
+{
+  const z = data.ground !== null ? data.ground : box.min.z;
+  const n = Math.ceil(extent / 0.5) * 2;
+  const grid = new THREE.GridHelper(n * 0.5, n, 0x9a9a9a, 0xcfcfcf);
+  grid.rotation.x = Math.PI / 2;                  // GridHelper lies in xz
+  grid.position.set(Math.round(centre.x), Math.round(centre.y), z);
+  scene.add(grid);
+}
+
+// ---- bodies: one group per body, its visuals placed in the body frame
+const palette = [0xe08a00, 0x3a7dc9, 0x8e5bb5, 0x2a9d8f, 0xb0413e, 0x6b8e23];
+function geometryOf(g) {
+  switch (g.type) {
+    case 'box': return new THREE.BoxGeometry(g.size[0], g.size[1], g.size[2]);
+    case 'sphere': return new THREE.SphereGeometry(g.radius, 48, 24);
+    case 'cylinder': {                            // URDF cylinders lie along z, three's along y
+      const c = new THREE.CylinderGeometry(g.radius, g.radius, g.length, 64);
+      c.rotateX(Math.PI / 2);
+      return c;
+    }
+    case 'mesh': {
+      const m = new THREE.BufferGeometry();
+      m.setAttribute('position', new THREE.Float32BufferAttribute(g.vertices, 3));
+      m.setIndex(g.triangles);
+      m.computeVertexNormals();
+      return m;
+    }
+  }
+  throw new Error('unknown geometry ' + g.type);
+}
+const bodies = data.bodies.map((body, b) => {
+  const group = new THREE.Group();
+  const material = new THREE.MeshLambertMaterial({ color: palette[b % palette.length] });
+  for (const g of body.geometry) {
+    const mesh = new THREE.Mesh(geometryOf(g), material);
+    mesh.position.fromArray(g.p);
+    mesh.quaternion.fromArray(g.q);
+    group.add(mesh);
+  }
+  scene.add(group);
+  return group;
+});
+
+// ---- paths: every body origin and every contact point, drawn up to the current time
+function path(stride, offset, source, colour) {
+  const xyz = new Float32Array(3 * ns);
+  for (let s = 0; s < ns; ++s)
+    for (let i = 0; i < 3; ++i) xyz[3 * s + i] = source[s][stride * offset + i];
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(xyz, 3));
+  const line = new THREE.Line(g, new THREE.LineBasicMaterial({ color: colour }));
+  scene.add(line);
+  return line;
+}
+const paths = [];
+for (let b = 0; b < nb; ++b)
+  if (data.bodies[b].moves) paths.push(path(7, b, data.poses, 0x1f5fbf));
+for (let c = 0; c < nc; ++c) paths.push(path(3, c, data.points, 0x555555));
+
+// ---- contacts: a dot at the point, an arrow for the reaction force
+let fmax = 0;
+for (let s = 0; s < ns; ++s)
+  for (let c = 0; c < nc; ++c) {
+    const f = data.forces[s];
+    fmax = Math.max(fmax, Math.hypot(f[3 * c], f[3 * c + 1], f[3 * c + 2]));
+  }
+const arrowScale = fmax > 0 ? 0.25 * extent / fmax : 0;   // metres per newton
+const contacts = data.contacts.map(() => {
+  const dot = new THREE.Mesh(new THREE.SphereGeometry(Math.min(0.012 * extent, 0.08 * data.size), 16, 8),
+                             new THREE.MeshBasicMaterial({ color: 0x111111 }));
+  const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 1, 0xc02030);
+  if (opts.contacts !== '0') scene.add(dot, arrow);   // contacts=0: the bodies alone
+  return { dot, arrow };
+});
+
+// ---- cameras: a perspective one the mouse orbits, or a fixed one from above
+const aspect = host.clientWidth / host.clientHeight;
+let camera;
+if (opts.view === 'top') {
+  const [cx, cy] = opts.center ? opts.center.split(',').map(Number) : [centre.x, centre.y];
+  const span = opts.span ? Number(opts.span) : extent;     // visible width in metres
+  camera = new THREE.OrthographicCamera(-span / 2, span / 2, span / 2 / aspect, -span / 2 / aspect,
+                                        0.01, 1000);
+  camera.userData.span = span;
+  camera.position.set(cx, cy, box.max.z + 100);
+  camera.up.set(0, 1, 0);
+  camera.lookAt(cx, cy, 0);
+} else {
+  camera = new THREE.PerspectiveCamera(40, aspect, extent / 1000, extent * 100);
+  camera.up.set(0, 0, 1);
+  camera.position.copy(centre).add(new THREE.Vector3(0.45, -0.8, 0.5).multiplyScalar(extent));
+  const controls = new OrbitControls(camera, renderer.domElement);
+  controls.target.copy(centre);
+  controls.update();
+  controls.addEventListener('change', () => render());
+}
+
+// ---- the state at time t
+const p0 = new THREE.Vector3(), p1 = new THREE.Vector3(), q0 = new THREE.Quaternion(),
+      q1 = new THREE.Quaternion(), f = new THREE.Vector3();
+function sampleAt(t) {                          // i with times[i] ≤ t < times[i+1], and the weight
+  let lo = 0, hi = ns - 1;
+  if (t <= data.times[0]) return [0, 0];
+  if (t >= data.times[hi]) return [hi, 0];
+  while (hi - lo > 1) {
+    const mid = (lo + hi) >> 1;
+    if (data.times[mid] <= t) lo = mid; else hi = mid;
+  }
+  return [lo, (t - data.times[lo]) / (data.times[hi] - data.times[lo])];
+}
+function lerp3(out, a, b, k, w) { return out.set(a[k], a[k + 1], a[k + 2]).lerp(p1.set(b[k], b[k + 1], b[k + 2]), w); }
+
+const info = document.getElementById('info');
+function show(t) {
+  const [i, w] = sampleAt(t), j = Math.min(i + 1, ns - 1);
+  for (let b = 0; b < nb; ++b) {
+    const A = data.poses[i], B = data.poses[j], k = 7 * b;
+    lerp3(p0, A, B, k, w);
+    q0.fromArray(A, k + 3).slerp(q1.fromArray(B, k + 3), w);
+    bodies[b].position.copy(p0);
+    bodies[b].quaternion.copy(q0);
+  }
+  const lines = [];
+  for (let c = 0; c < nc; ++c) {
+    lerp3(p0, data.points[i], data.points[j], 3 * c, w);
+    lerp3(f, data.forces[i], data.forces[j], 3 * c, w);
+    contacts[c].dot.position.copy(p0);
+    const a = contacts[c].arrow, len = f.length() * arrowScale;
+    a.visible = len > 1e-9;
+    if (a.visible) {
+      a.position.copy(p0);
+      a.setDirection(f.clone().normalize());
+      a.setLength(len, Math.min(0.3 * len, 0.04 * extent), Math.min(0.15 * len, 0.02 * extent));
+    }
+    lines.push(`${data.contacts[c].name}: |f| = ${f.length().toFixed(3)} N`);
+  }
+  const drawn = Math.max(2, i + 2);
+  for (const p of paths) p.geometry.setDrawRange(0, Math.min(drawn, ns));
+  info.textContent = `${data.title}\n` + lines.join('\n') +
+    (arrowScale > 0 ? `\narrows: 1 m = ${(1 / arrowScale).toPrecision(3)} N` : '');
+  document.getElementById('time').textContent =
+    `t = ${t.toFixed(3)} s / ${t1.toFixed(3)} s`;
+  render();
+}
+function render() { renderer.render(scene, camera); }
+
+// ---- play / pause / scrub
+const slider = document.getElementById('slider'), button = document.getElementById('play');
+let t = opts.t !== undefined ? Math.min(Math.max(Number(opts.t), t0), t1) : t0;
+let playing = false, wall = 0;
+const toSlider = (x) => Math.round(1000 * (x - t0) / Math.max(t1 - t0, 1e-12));
+function setPlaying(on) {
+  playing = on && ns > 1;
+  button.textContent = playing ? 'pause' : 'play';
+  wall = performance.now();
+  if (playing) requestAnimationFrame(tick);
+}
+function tick(now) {
+  if (!playing) return;
+  t += (now - wall) / 1000;
+  wall = now;
+  if (t >= t1) { t = t1; setPlaying(false); }
+  slider.value = toSlider(t);
+  show(t);
+  if (playing) requestAnimationFrame(tick);
+}
+button.addEventListener('click', () => {
+  if (!playing && t >= t1) t = t0;
+  setPlaying(!playing);
+});
+slider.addEventListener('input', () => {
+  setPlaying(false);
+  t = t0 + (t1 - t0) * slider.value / 1000;
+  show(t);
+});
+window.addEventListener('keydown', (e) => { if (e.key === ' ') button.click(); });
+window.addEventListener('resize', () => {
+  renderer.setSize(host.clientWidth, host.clientHeight);
+  const a = host.clientWidth / host.clientHeight;
+  if (camera.isPerspectiveCamera) camera.aspect = a;
+  else {                                        // keep the width in metres; the height follows
+    camera.top = camera.userData.span / 2 / a;
+    camera.bottom = -camera.top;
+  }
+  camera.updateProjectionMatrix();
+  render();
+});
+slider.value = toSlider(t);
+show(t);
+if (opts.play === '1') setPlaying(true);
