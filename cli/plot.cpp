@@ -50,7 +50,7 @@ std::string header(const std::string& png, const std::string& title, int plots) 
   std::ostringstream gp;
   gp << "# Written by appell plot; redraw with: gnuplot " << fs::path(png).stem().string() << ".gp\n"
      << "set encoding utf8\nset terminal pngcairo size 960," << (plots > 1 ? 760 : 560)
-     << " noenhanced font 'sans,10'\nset output " << quoted(png) << "\nset grid\nset key outside right\n"
+     << " noenhanced font 'sans,10'\nset output " << quoted(png) << "\nset grid\nset key outside right\nset lmargin 13\nset rmargin 24\n"
      << "set xlabel 't [s]'\n";
   if (plots > 1) gp << "set multiplot layout " << plots << ",1 title " << quoted(title) << "\n";
   else gp << "set title " << quoted(title) << "\n";
@@ -133,7 +133,7 @@ std::vector<std::string> writePlots(const std::string& csv, const std::string& d
     for (size_t i = 0; i < n; ++i) dE[i] = E[i] - E[0];
     writeData(dir / "energy.dat", {"t", "E", "E-E0"}, {t, E, dE});
     draw("energy", header("energy.png", "energy — " + run, 2) +
-                       "set ylabel 'E [J]'\nplot 'energy.dat' using 1:2 with lines lw 2 title 'E'\n"
+                       "set ylabel 'E [J]'\nset format y '%.12g'\nplot 'energy.dat' using 1:2 with lines lw 2 title 'E'\n"
                        "set ylabel 'E − E(0) [J]'\nset format y '%.2g'\n"
                        "plot 'energy.dat' using 1:3 with lines lw 2 lc rgb '#c02030' title 'E − E(0)'\n"
                        "unset multiplot\n");
@@ -184,7 +184,7 @@ std::vector<std::string> writePlots(const std::string& csv, const std::string& d
     writeData(dir / "contacts.dat", names, cols);
     draw("contacts", header("contacts.png", "contacts — " + run, 2) +
                          "set ylabel 'normal load [N]'\n" + load_plot + "\n" +
-                         "set ylabel '|f_t| / f_n'\nset yrange [0:*]\n" + demand_plot +
+                         "set ylabel '|f_t| / f_n'\nset yrange [0:*]\nset offsets 0, 0, graph 0.08, 0\n" + demand_plot +
                          "\nunset multiplot\n");
   }
   // Paths from above: joint origins with an x and a y, and contact points.
