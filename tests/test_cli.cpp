@@ -39,7 +39,7 @@ double field(const std::string& text, const std::string& pattern) {
 
 TEST(Cli, HelpAndUsage) {
   EXPECT_EQ(sh("--help").status, 0);
-  for (const char* cmd : {"run", "info", "equilibria", "linearize"}) {
+  for (const char* cmd : {"run", "info", "equilibria", "linearize", "view", "plot"}) {
     const Result r = sh(std::string(cmd) + " --help");
     EXPECT_EQ(r.status, 0) << cmd;
     EXPECT_NE(r.output.find("usage: appell " + std::string(cmd)), std::string::npos) << r.output;
