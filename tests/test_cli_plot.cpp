@@ -6,6 +6,7 @@
 #include <appell/trajectory_reader.hpp>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -21,7 +22,8 @@ namespace fs = std::filesystem;
 
 const std::string kAppell = std::string(APPELL_BINARY_DIR) + "/cli/appell";
 const std::string kDisk = std::string(APPELL_SOURCE_DIR) + "/examples/rolling_disk/rolling_disk.urdf";
-const fs::path kWork = fs::path(APPELL_BINARY_DIR) / "test_cli_plot";
+// One folder per process: ctest runs each test of this file as its own process, in parallel.
+const fs::path kWork = fs::path(APPELL_BINARY_DIR) / ("test_cli_plot_" + std::to_string(getpid()));
 
 struct Result {
   int status;
@@ -84,6 +86,7 @@ class CliPlot : public ::testing::Test {
     fs::create_directories(kWork);
     run_ = sh("run " + kDisk + " --duration 1 --quiet --plot --out " + (kWork / "disk.csv").string());
   }
+  static void TearDownTestSuite() { fs::remove_all(kWork); }
   static Result run_;
 };
 Result CliPlot::run_;
