@@ -149,18 +149,24 @@ double reach(const Geometry& g) {
 struct Frame {
   double t;
   std::vector<double> poses, points, forces;  // 7 per body, 3 per constraint, 3 per constraint
+  std::vector<double> supports;                // 7 per support: its frame in the world
 };
+
+void appendPose(std::vector<double>& out, const SE3& X) {
+  const Quat r(X.R);
+  out.insert(out.end(), {X.p.x(), X.p.y(), X.p.z(), r.x(), r.y(), r.z(), r.w()});
+}
 
 Frame frameAt(const Scene& scene, Data& data, std::vector<RowBlock>& blocks, double t,
               const VecX& q, const VecX& v, const VecX& lambda) {
   const Model& m = scene.model;
   Frame f{t, {}, {}, {}};
   forwardKinematics(m, data, q, v);
-  for (int b = 0; b < m.nbodies; ++b) {
-    const SE3& X = data.oMi[b];
-    const Quat r(X.R);
-    f.poses.insert(f.poses.end(), {X.p.x(), X.p.y(), X.p.z(), r.x(), r.y(), r.z(), r.w()});
-  }
+  for (int b = 0; b < m.nbodies; ++b) appendPose(f.poses, data.oMi[b]);
+  // A support frame moves as its motion says, or rides on its body (supports.hpp).
+  for (const Support& s : scene.supports)
+    appendPose(f.supports, s.body >= 0 ? data.oMi[s.body] * std::get<StaticMotion>(s.motion).pose
+                                       : supportState(s.motion, t).pose);
   int row = 0;
   for (size_t c = 0; c < scene.constraints.size(); ++c) {
     const Constraint& con = *scene.constraints[c];
@@ -248,16 +254,35 @@ std::string pageJson(const Scene& scene, const std::vector<Frame>& frames) {
   }
   j.close(']').key("contacts").open('[');
   for (const auto& c : scene.constraints) j.open('{').key("name").str(c->name()).close('}');
-  j.close(']').key("size").num(std::max(size, 1e-3)).key("ground").num(groundHeight(scene));
+  // Supports other than the ground (the grid stands for that one): planes and spheres.
+  const double ground = groundHeight(scene);
+  j.close(']').key("supports").open('[');
+  for (const Support& s : scene.supports) {
+    j.open('{').key("name").str(s.name).key("type");
+    if (const Plane* p = std::get_if<Plane>(&s.surface)) {
+      const SE3 X = supportState(s.motion, 0).pose;
+      const bool is_ground = s.body < 0 && !isMoving(s.motion) &&
+                             (X.R * p->normal).z() > 1 - 1e-12 && X.apply(p->point).z() == ground;
+      j.str(is_ground ? "ground" : "plane").key("point").vec(p->point).key("normal").vec(p->normal);
+    } else if (const SphereSurface* sp = std::get_if<SphereSurface>(&s.surface)) {
+      j.str("sphere").key("centre").vec(sp->centre).key("radius").num(sp->radius);
+      j.key("inside").raw(sp->side == SphereSurface::Side::Inside ? "true" : "false");
+    } else {
+      j.str("terrain");  // not drawn yet
+    }
+    j.close('}');
+  }
+  j.close(']').key("size").num(std::max(size, 1e-3)).key("ground").num(ground);
   j.key("times").open('[');
   for (const Frame& f : frames) j.num(f.t);
   j.close(']');
-  for (const char* name : {"poses", "points", "forces"}) {
-    j.key(name).open('[');
-    for (const Frame& f : frames) {
-      const std::string n = name;
-      j.vec(n == "poses" ? f.poses : n == "points" ? f.points : f.forces);
-    }
+  for (const auto member : {&Frame::poses, &Frame::points, &Frame::forces, &Frame::supports}) {
+    j.key(member == &Frame::poses    ? "poses"
+          : member == &Frame::points ? "points"
+          : member == &Frame::forces ? "forces"
+                                     : "supportPoses")
+        .open('[');
+    for (const Frame& f : frames) j.vec(f.*member);
     j.close(']');
   }
   return j.close('}').text();

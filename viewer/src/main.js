@@ -35,6 +35,12 @@ for (let s = 0; s < ns; ++s)
     box.expandByPoint(new THREE.Vector3(o[k], o[k + 1], o[k + 2]));
   }
 box.expandByScalar(data.size);
+data.supports.forEach((s, k) => {              // a bowl or a globe: frame all of it
+  if (s.type !== 'sphere') return;
+  const o = data.supportPoses[0], c = new THREE.Vector3().fromArray(s.centre)
+    .applyQuaternion(new THREE.Quaternion().fromArray(o, 7 * k + 3)).add(new THREE.Vector3().fromArray(o, 7 * k));
+  box.union(new THREE.Box3().setFromCenterAndSize(c, new THREE.Vector3().setScalar(2 * s.radius)));
+});
 const centre = box.getCenter(new THREE.Vector3());
 const extent = Math.max(box.getSize(new THREE.Vector3()).length(), 1e-3);
 
@@ -77,6 +83,30 @@ const bodies = data.bodies.map((body, b) => {
     mesh.position.fromArray(g.p);
     mesh.quaternion.fromArray(g.q);
     group.add(mesh);
+  }
+  scene.add(group);
+  return group;
+});
+
+// ---- supports other than the ground: a disc with spokes for a plane (so that
+// a turntable's turn shows), a wire sphere for a globe or a bowl; each in its
+// support frame, placed per sample (moving supports, supports on bodies)
+const supportMaterial = new THREE.LineBasicMaterial({ color: 0x6a7f99, transparent: true, opacity: 0.7 });
+const supports = data.supports.map((s) => {
+  const group = new THREE.Group();
+  if (s.type === 'plane') {
+    const disc = new THREE.PolarGridHelper(0.5 * extent, 16, 8, 64, 0x6a7f99, 0x9fb0c4);
+    disc.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), new THREE.Vector3(...s.normal));
+    disc.position.fromArray(s.point);
+    group.add(disc);
+  } else if (s.type === 'sphere') {
+    // A bowl (rolled on inside) is drawn as its lower half, a globe whole.
+    const g = s.inside ? new THREE.SphereGeometry(s.radius, 24, 8, 0, 2 * Math.PI, Math.PI / 2, Math.PI / 2)
+                       : new THREE.SphereGeometry(s.radius, 24, 16);
+    g.rotateX(Math.PI / 2);                      // three's pole is y, the support frame's z
+    const wire = new THREE.LineSegments(new THREE.WireframeGeometry(g), supportMaterial);
+    wire.position.fromArray(s.centre);
+    group.add(wire);
   }
   scene.add(group);
   return group;
@@ -160,6 +190,13 @@ function show(t) {
     q0.fromArray(A, k + 3).slerp(q1.fromArray(B, k + 3), w);
     bodies[b].position.copy(p0);
     bodies[b].quaternion.copy(q0);
+  }
+  for (let k = 0; k < supports.length; ++k) {
+    const A = data.supportPoses[i], B = data.supportPoses[j], o = 7 * k;
+    lerp3(p0, A, B, o, w);
+    q0.fromArray(A, o + 3).slerp(q1.fromArray(B, o + 3), w);
+    supports[k].position.copy(p0);
+    supports[k].quaternion.copy(q0);
   }
   const lines = [];
   for (let c = 0; c < nc; ++c) {
