@@ -277,6 +277,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
   const SolverOptions& o = ws.options;
   for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].IA = model.spatial_inertia[i];
   ws.redundant = 0;
+  ws.nseeds = 0;
 
   for (int i = model.nbodies - 1; i >= 0; --i) {
     Node& nd = ws.nodes[i];
@@ -287,6 +288,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     //    whenever the stack would exceed 12 rows and once at the end.
     nd.ncomp = 0;
     nd.nK = 0;
+    nd.nfree = 0;
     nd.K.resize(0, 6);
     int nb = 0;
     Compression* cur = &nd.comp[0];
@@ -297,7 +299,9 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       bool soft = false;
       for (int s = 0; s < cur->nseg; ++s) soft |= softSegment(ws, nd, nd.ncomp, cur->seg[s]);
       cur->soft = false;
-      ws.redundant += soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
+      // Dropped rows with no compliance: redundant, their multipliers free.
+      cur->nfree = soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
+      nd.nfree += cur->nfree;
       cur = &nd.comp[++nd.ncomp];
       cur->nseg = 0;
     };
@@ -332,7 +336,11 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     const bool soft_rows = nd.ncomp > 0 && nd.comp[nd.ncomp - 1].soft;
     if (soft_rows || !(j.nv == 1 ? splitOneDof(o, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))
       splitSoft(ws, j, p < 0, nd, H);
-    if (p < 0) ws.redundant += nd.npass;  // rows no joint can move: zero rows of A
+    if (p < 0) nd.nfree += nd.npass;  // rows no joint can move: their combinations are zero rows of A
+    if (nd.nfree > 0) {  // tree_solver/min_norm.cpp starts from these bodies
+      ws.redundant += nd.nfree;
+      ws.seeds[ws.nseeds++] = i;
+    }
     if (nd.npass > 0) nd.kpc.noalias() = nd.Kpass * nd.c;  // for the bias pass
     if (p >= 0) {
       nd.Hc.noalias() = H * nd.c;  // the velocity-product term of the bias pass

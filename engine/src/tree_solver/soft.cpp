@@ -116,16 +116,20 @@ bool softCompressionRhs(Compression& cp, const BufVec& t, double tol, double& re
   return res <= tol;
 }
 
-void softDroppedMultipliers(const Compression& cp, BufVec& lam) {
+void softDroppedMultipliers(const Compression& cp, BufVec& lam, bool homogeneous) {
   const int r = cp.rank, ndr = cp.nrows - r, ne = cp.nelim;
   lam.segment(r, ndr).setZero();
   if (ne == 0) return;
   // μ_d = Φ_dd⁺ (r_d − Φ_dk μ_k) = U_e Σ_e⁻¹ (Σ_e⁻¹ U_eᵀ r_d − W_eᵀ F_kᵀ μ_k);
   // zero along the redundant directions.
   BufVec y(ne);
-  y.noalias() = cp.Ud.leftCols(ne).transpose() * cp.rd;
-  y.array() *= cp.sInv.array();
-  y.noalias() -= cp.FkWe.transpose() * lam.head(r);
+  if (homogeneous) {
+    y.noalias() = -cp.FkWe.transpose() * lam.head(r);
+  } else {
+    y.noalias() = cp.Ud.leftCols(ne).transpose() * cp.rd;
+    y.array() *= cp.sInv.array();
+    y.noalias() -= cp.FkWe.transpose() * lam.head(r);
+  }
   y.array() *= cp.sInv.array();
   lam.segment(r, ndr).noalias() = cp.Ud.leftCols(ne) * y;
 }

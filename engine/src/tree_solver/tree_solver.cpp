@@ -72,6 +72,8 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   ws.a_world.setZero();
   ws.vdot = VecX::Zero(model.nv);
   ws.lambda = VecX::Zero(ws.m);
+  ws.seeds.assign(model.nbodies, -1);
+  ws.region.assign(model.nbodies, -1);
   ws.fsub.assign(model.nbodies, Vec6::Zero());
   ws.floop.assign(model.nbodies, Vec6::Zero());
   ws.a0.assign(model.nbodies, Vec6::Zero());
@@ -89,6 +91,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
       ws.inertia_root[i] = es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() *
                            es.eigenvectors().transpose();
     }
+    ws.loop_null = MatX::Zero(ws.m, k);
     ws.vdot0 = VecX::Zero(model.nv);
     ws.lambda0 = VecX::Zero(ws.m);
     for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp, &ws.loop_resid, &ws.loop_share, &ws.loop_fnorm})
@@ -161,6 +164,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     return;
   }
   ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;
+  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);
   out.vdot = ws.vdot;
   out.lambda = ws.lambda;
   detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
@@ -201,6 +205,8 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     ws.last_error = detail::describeFailure(model, data, ws);
     return false;
   }
+  if (ws.redundant + static_cast<int>(ws.loops.size()) - ws.loop_rank > 0)
+    detail::minimumNorm(model, ws, ws.lambda);
   v += ws.vdot;
   impulse = -ws.lambda;  // the shared convention: v⁺ = v − M⁻¹Aᵀμ
   return true;

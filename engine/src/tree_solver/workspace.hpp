@@ -25,6 +25,16 @@ using KVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using BufVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 12, 1>;
 using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 using StackMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12>;
+/// Rows of a stack's triangularised least-squares system that fix its free
+/// multipliers (tree_solver/min_norm.cpp): ≤ 12 × (≤ 12 unknowns + right side).
+using AugMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 13>;
+
+/// A least-squares system ‖F [x; 1]‖ of at most 12 rows and 12 unknowns
+/// (tree_solver/min_norm.cpp), column-major: col[k][r] = F(r, k).
+struct LsSystem {
+  int rows = 0, cols = 0;
+  alignas(16) double col[13][12];
+};
 
 /// A kept singular value of K S below this (rows equilibrated, S unit) is a
 /// joint that can barely move its rows: the rows are not resolved there but
@@ -65,6 +75,14 @@ struct Compression {
   BufVec sInv;                 ///< 1/Σ_e of the eliminated directions
   StackMat FkWe;               ///< F_k W_e (rank × nelim)
   BufVec rd;                   ///< dropped right sides Q₂ᵀ E r of the last bias pass
+
+  // Minimum-norm λ (tree_solver/min_norm.cpp): the dropped combinations with
+  // no compliance are null vectors of Aᵀ, their multipliers t are free.
+  int nfree = 0;               ///< free multipliers t (dropped rows, less the eliminated ones)
+  AugMat mnTop;                ///< nfree rows fixing t from δμ: R_tt t + R_tμ δμ + r_t = 0
+  SmallMat mnR;                ///< cost-to-go of the kept rows' δμ: ½‖R δμ + ρ‖²
+  KVec mnRho;
+  KVec dmu;                    ///< δμ of the replay
 };
 
 /// A constraint whose rows act on one body of the tree.
@@ -168,6 +186,13 @@ struct Node {
   KVec lamInv;                            ///< 1/Λ₁
   KVec kv;                                ///< Vphiᵀ k' (bias pass)
 
+  // Minimum-norm λ (tree_solver/min_norm.cpp).
+  int nfree = 0;                          ///< free multipliers here (dropped rows, rows to the world)
+  bool mn_active = false;                 ///< λ of this body's rows depends on free multipliers
+  SmallMat mnR;                           ///< cost-to-go of the handed-up rows' δν: ½‖R δν + ρ‖²
+  KVec mnRho;
+  KVec dnu;                               ///< δν of the replay
+
   std::vector<Segment> groups;            ///< own blocks, then children
   std::vector<Compression> comp;          ///< sized groups.size() + 1
 };
@@ -243,6 +268,14 @@ struct TreeWorkspace {
   std::vector<Vec6> floop;                ///< subtree loop-row force (body frame, freeShare)
   int loop_rank = 0;
 
+  // Minimum-norm λ (tree_solver/min_norm.cpp): bodies with free multipliers
+  // (recorded by the factor pass, leaves first), the bodies whose λ they move
+  // (parents first), and the loop closure's null vectors of Aᵀ.
+  std::vector<int> seeds, region;
+  int nseeds = 0, nregion = 0;
+  LsSystem mnF;                           ///< one stack's least-squares system
+  MatX loop_null;                         ///< m × k
+
   std::string last_error;
 };
 
@@ -301,13 +334,19 @@ void splitSoft(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H);
 /// Right sides through a compliant compression; false if the redundant part
 /// is inconsistent (residual in `res`).
 bool softCompressionRhs(Compression& cp, const BufVec& t, double tol, double& res);
-/// Multipliers of a compliant compression's dropped rows, into lam[rank…].
-void softDroppedMultipliers(const Compression& cp, BufVec& lam);
+/// Multipliers of a compliant compression's dropped rows, into lam[rank…];
+/// `homogeneous`: with zero right sides (their change when lam[0…rank) changes).
+void softDroppedMultipliers(const Compression& cp, BufVec& lam, bool homogeneous = false);
 /// Bias pass of a compliant node: its gradient contribution g for the parent
 /// (without H c) and its handed-up right sides.
 void softBias(const Joint& j, Node& nd, const VecX& tau, Vec6& pa);
 /// Forward pass of a compliant node: q̈, a, and the multipliers of its rows.
 void softForward(const Joint& j, Node& nd, const Vec6& abar, VecX& vdot);
+/// λ ← the minimum-norm solution of Aᵀλ = Aᵀλ_given (tree_solver/min_norm.cpp):
+/// λ minus its projection on null(Aᵀ), spanned by the free multipliers of the
+/// tree rows and the loop closure's redundant directions. Nothing to do when
+/// no row is redundant.
+void minimumNorm(const Model& model, TreeWorkspace& ws, VecX& lambda);
 /// "…" message naming the constraints involved in the inconsistency of ws.failure.
 std::string describeFailure(const Model& model, const Data& data, TreeWorkspace& ws);
 
