@@ -7,9 +7,14 @@
 //   Appell       dense null-space / Maggi equations          appell_maggi.hpp
 //   Tree         Gauss' principle by dynamic programming on
 //                the kinematic tree, O(n + m) (the default)  tree_solver.hpp
-// With redundant rows λ is not unique: every solver returns the minimum-norm λ
-// and counts the redundant rows. Inconsistent rows (no v̇ satisfies them) are an
-// error, reported in the result — never a silently wrong v̇.
+// The λ contract (the one statement of it; docs and solvers refer here):
+// with redundant rows λ is not unique, and every formulation returns the same
+// one, the minimum-norm solution of Aᵀλ = M v̇ + h − τ (equivalently the
+// unique solution in range(A)), so reported reactions never depend on the
+// formulation. The impulse of projectVelocity() is the minimum-norm one too.
+// `redundant` = m − rank(A), the rank decided with SolverOptions' tolerances
+// on equilibrated rows. Inconsistent rows (no v̇ satisfies them) are an error,
+// reported in the result — never a silently wrong v̇.
 #pragma once
 
 #include <appell/constraint_set.hpp>
@@ -32,7 +37,7 @@ struct SolverOptions {
 
 struct ConstrainedResult {
   VecX vdot;                 ///< nv
-  VecX lambda;               ///< m, one multiplier per row (minimum norm)
+  VecX lambda;               ///< m, one multiplier per row (minimum norm: see above)
   VecX reaction;             ///< nv, Aᵀλ
   int rank = 0;              ///< rank of A
   int redundant = 0;         ///< m − rank

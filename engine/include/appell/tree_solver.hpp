@@ -12,7 +12,9 @@
 // move are handed to the parent; the coupling of the particular part enters
 // the parent's articulated inertia and bias through the projector P = 1 − S G⁺ K.
 // Forward pass: accelerations, then multipliers from joint force balance,
-// unrolled through the compressions with their adjoints.
+// unrolled through the compressions with their adjoints. When rows are
+// redundant, one more sweep over the bodies they reach makes λ the global
+// minimum-norm one (the contract of constrained_dynamics.hpp).
 //
 // Rows between two moving bodies and joint-space rows close loops: they are
 // auxiliary unknowns, found from a small rank-revealing Schur complement after

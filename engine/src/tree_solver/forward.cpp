@@ -20,8 +20,8 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
 
     if (p < 0 && nd.npass > 0) {
       // Rows no joint can move act on the world's (prescribed) acceleration:
-      // they must already hold. Their multipliers are zero (minimum norm:
-      // these rows of A vanish).
+      // they must already hold. Their combinations are zero rows of A, whose
+      // multipliers are free: zero here, then chosen by tree_solver/min_norm.cpp.
       nd.nu.setZero(nd.npass);
       if (check) {
         KVec lhs(nd.npass);

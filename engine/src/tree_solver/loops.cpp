@@ -12,8 +12,8 @@
 // of Z loses eps·cond(Z), where solving with S itself would lose
 // eps·cond(Z)² — the squaring that once needed iterative refinement. The rank
 // rule is the dense solvers' (relative to the largest singular value of the
-// equilibrated Z); redundant loop rows get λ = 0 (minimum norm),
-// inconsistent ones are named.
+// equilibrated Z); redundant loop directions get λ = 0 here (tree_solver/
+// min_norm.cpp then removes them from λ globally), inconsistent ones are named.
 #include "tree_solver/workspace.hpp"
 
 #include <algorithm>

@@ -5,8 +5,8 @@
 // A compression replaced the stacked rows B (right sides r) by K = Q₁ᵀ E B,
 // so a multiplier μ on K is the force Kᵀμ = Bᵀ(E Q₁ μ): the stacked rows get
 // λ = E Q₁ μ. Dropped rows (redundant) get exactly the share E Q₁ μ assigns
-// them — Aᵀλ and v̇ are exact; λ is the minimum-norm choice within each
-// compression, and unique wherever A has full row rank.
+// them — Aᵀλ and v̇ are exact, λ is one solution; tree_solver/min_norm.cpp
+// then makes it the minimum-norm one when rows are redundant.
 #include "tree_solver/workspace.hpp"
 
 #include <algorithm>
