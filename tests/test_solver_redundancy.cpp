@@ -1,10 +1,12 @@
-// Rank handling of the dense solvers: redundant rows (minimum-norm λ, counted),
+// Rank handling of the dense solvers (and the minimum-norm split of the tree
+// solver, the contract of constrained_dynamics.hpp): redundant rows (minimum-norm λ, counted),
 // inconsistent rows (an error naming the rows, never a wrong answer), rows no
 // motion can influence, and the seed-002 sleigh: equilibrium at φ = 0 with
 // λ = ±m g sin α, where the fixed partition ẋ = ẏ cot φ is singular; the
 // coordinate partition re-chooses itself there and stays accurate.
 #include <appell/appell_maggi.hpp>
 #include <appell/kkt.hpp>
+#include <appell/tree_solver.hpp>
 
 #include "random_tree.hpp"
 #include "test_solver_rows.hpp"
@@ -53,7 +55,10 @@ TEST(SolverRedundancy, ScaledDuplicateRowsGiveMinimumNormSplit) {
   ASSERT_TRUE(r1.ok);
   EXPECT_EQ(r1.redundant, 0);
   evaluateConstraints(model, data, c, cd, 0, q, v);
-  for (auto& s : allSolvers(model, c)) {
+  auto solvers = allSolvers(model, c);
+  solvers.push_back(makeTreeSolver(model, c));
+  for (auto& s : solvers) {
+    SCOPED_TRACE(toString(s->formulation()));
     ConstrainedResult r;
     s->solve(model, data, c, cd, q, v, tau, r);
     ASSERT_TRUE(r.ok) << r.error;
@@ -81,7 +86,10 @@ TEST(SolverRedundancy, ContradictoryRowsAreAnErrorNamingThem) {
   ConstraintData cd(model, c);
   const VecX q = neutralConfiguration(model), v = VecX::Zero(6), tau = VecX::Zero(6);
   evaluateConstraints(model, data, c, cd, 0, q, v);
-  for (auto& s : allSolvers(model, c)) {
+  auto solvers = allSolvers(model, c);
+  solvers.push_back(makeTreeSolver(model, c));
+  for (auto& s : solvers) {
+    SCOPED_TRACE(toString(s->formulation()));
     ConstrainedResult r;
     s->solve(model, data, c, cd, q, v, tau, r);
     EXPECT_FALSE(r.ok);

@@ -2,7 +2,8 @@
 // result vectors have their sizes: every allocation of this executable is
 // counted (operator new and malloc & co., which Eigen uses), and the count
 // over repeated solves must be zero — on random trees with redundant rows,
-// with loop rows, and with rows handed up with their compliance.
+// with loop rows (also redundant ones), and with rows handed up with their
+// compliance — the minimum-norm step included.
 #include "test_tree_solver_common.hpp"
 
 #include <gtest/gtest.h>
@@ -71,5 +72,23 @@ TEST(TreeSolverAllocations, NoneWithLoopRows) {
   s.local.push_back(std::make_shared<LocalRows>("loop", 5, Ka, 9, Kb));
   s.joint.push_back(std::make_shared<JointRows>("joint", MatX::Random(1, s.model.nv)));
   makeConsistent(s, rng);
+  expectNoAllocation(s);
+}
+
+TEST(TreeSolverAllocations, NoneWithRedundantLoopRows) {
+  // The minimum-norm step (tree_solver/min_norm.cpp) with both kinds of
+  // redundant directions: tree rows dropped at compressions and a loop row
+  // that copies a tree row (the loop closure's null direction).
+  std::mt19937 rng(34);
+  System s = randomSystem(12, true, rng, RowRecipe{0.3, 0.3, 2});
+  Rows Ka(1, 6), Kb(1, 6);
+  Ka.setRandom();
+  Kb.setRandom();
+  s.local.push_back(std::make_shared<LocalRows>("loop", 5, Ka, 9, Kb));
+  addJointCopyOfLastRow(s, "copy", 2.0);
+  makeConsistent(s, rng);
+  const ConstrainedResult out = treeSolve(s);
+  ASSERT_TRUE(out.ok) << out.error;
+  EXPECT_GT(out.redundant, 1);
   expectNoAllocation(s);
 }
