@@ -32,8 +32,6 @@ struct Data {
   std::vector<Mat6X> U;    ///< IA S
   std::vector<Eigen::Matrix<double, 6, 6>> Dinv;  ///< (Sᵀ IA S)⁻¹, top-left nv×nv used
   std::vector<Vec6> u;     ///< τ − Sᵀ pA (first nv used)
-
-  MatX J;                  ///< 6 × nv scratch for Jacobians
 };
 
 }  // namespace appell

@@ -68,10 +68,8 @@ struct Model {
   std::vector<std::string> body_names;
   std::vector<std::string> joint_names;
   std::vector<std::vector<int>> children;
-  /// Body that velocity index k belongs to, and the depth-first "support":
-  /// for each body, the bodies on its path to the root (itself first).
+  /// Body that velocity index k belongs to.
   std::vector<int> body_of_v;
-  std::vector<std::vector<int>> support;
   Vec3 gravity{0, 0, -9.81};
 
   int bodyIndex(const std::string& name) const;   ///< −1 if absent

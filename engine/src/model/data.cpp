@@ -8,8 +8,7 @@ Data::Data(const Model& model)
       nle(VecX::Zero(model.nv)), M(MatX::Zero(model.nv, model.nv)), ddq(VecX::Zero(model.nv)),
       Ic(model.nbodies, Mat6::Zero()), IA(model.nbodies, Mat6::Zero()),
       pA(model.nbodies, Vec6::Zero()), c(model.nbodies, Vec6::Zero()),
-      U(model.nbodies), Dinv(model.nbodies, Mat6::Zero()), u(model.nbodies, Vec6::Zero()),
-      J(MatX::Zero(6, model.nv)) {
+      U(model.nbodies), Dinv(model.nbodies, Mat6::Zero()), u(model.nbodies, Vec6::Zero()) {
   for (int i = 0; i < model.nbodies; ++i) U[i] = Mat6X::Zero(6, model.joints[i].nv);
 }
 

@@ -224,9 +224,6 @@ Model ModelBuilder::build() const {
   for (int i = 0; i < n; ++i) {
     for (int k = 0; k < i; ++k)
       if (m.joint_names[k] == m.joint_names[i]) fail(m.body_names[i], "joint name '" + m.joint_names[i] + "' is used twice");
-    std::vector<int> path;
-    for (int b = i; b >= 0; b = m.parent[b]) path.push_back(b);
-    m.support.push_back(path);
   }
   checkMasslessJoints(m);
   return m;

@@ -84,10 +84,11 @@ struct InitialStateReport {
 /// Checks that (q0, v0) satisfies every constraint: |A v + b| and the
 /// holonomic gaps within `tol`. If not: with `project` false, throws
 /// SceneError naming the worst contact, its row and the residual; with
-/// `project` true, moves q0 onto the gaps (Gauss–Newton in the local
-/// coordinates, minimum-norm steps) and v0 onto A v + b = 0 (the M-metric
-/// projection v ← v − M⁻¹Aᵀ(A M⁻¹Aᵀ)⁺(A v + b)), then checks again and
-/// throws if that did not succeed.
+/// `project` true, puts the state on the constraints with the engine's
+/// projection (projectState, projection.hpp: Newton on the gaps with the
+/// least-M-norm steps, then the impulse solve of the scene's formulation,
+/// v ← v − M⁻¹Aᵀμ with A v + b = 0), then checks again and throws, naming
+/// the worst contact and row, if that did not succeed.
 InitialStateReport checkInitialState(Scene& scene, bool project, double tol = 1e-8);
 
 }  // namespace appell

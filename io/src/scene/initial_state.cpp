@@ -2,13 +2,10 @@
 // put it there: q onto the holonomic gaps, then v onto A v + b = 0.
 #include <appell/urdf.hpp>
 
-#include <appell/configuration.hpp>
-#include <appell/dynamics.hpp>
-#include <appell/kinematics.hpp>
+#include <appell/constrained_dynamics.hpp>
+#include <appell/projection.hpp>
 
-#include <Eigen/Cholesky>
-#include <Eigen/QR>
-
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -82,41 +79,38 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
     throw SceneError(s.str());
   }
 
-  // Positions: Gauss–Newton on the holonomic gaps in local coordinates θ,
-  // where ∂g/∂θ at θ = 0 is the row of A (the row is ġ = A v + b and q̇ = G v).
-  VecX q = scene.q0, theta(model.nv), qn(model.nq);
-  for (int it = 0; it < 50; ++it) {
-    if (gapResidual(cd) <= 0.01 * tol) break;
-    std::vector<int> rows;
-    for (int i = 0; i < cd.m; ++i)
-      if (cd.holonomic[i]) rows.push_back(i);
-    MatX H(rows.size(), model.nv);
-    VecX g(rows.size());
-    for (int k = 0; k < static_cast<int>(rows.size()); ++k) {
-      H.row(k) = cd.A.row(rows[k]);
-      g(k) = cd.gap(rows[k]);
-    }
-    theta = -Eigen::CompleteOrthogonalDecomposition<MatX>(H).solve(g);
-    retract(model, q, theta, qn);
-    q = qn;
-    ++report.iterations;
-    evaluateConstraints(model, data, scene.constraints, cd, 0.0, q, scene.v0);
-    if (cd.singular) singular(scene, cd);
-    if (!std::isfinite(gapResidual(cd))) notFinite(scene, {0, gapResidual(cd), false, 0});
+  // The engine's projection (projection.hpp): Newton on the holonomic gaps in
+  // the mass metric, then the solver's impulse solve v ← v − M⁻¹Aᵀμ onto
+  // A v + b = 0 — the correction that disturbs the kinetic energy least. The
+  // solver is the scene's own formulation, so a failure here is the one the
+  // run would meet; every formulation returns the same v (it is unique).
+  ProjectionOptions popt;
+  if (tol > 0) popt.gap_tol = 0.01 * tol;
+  popt.stall_tol = std::min(popt.stall_tol, popt.gap_tol);
+  popt.max_iterations = 50;
+  PositionProjector projector(model, scene.constraints, popt);
+  auto solver = makeSolver(formulationFromString(scene.settings.formulation), model,
+                           scene.constraints);
+  VecX q = scene.q0, v = scene.v0, impulse(cd.m);
+  const StateProjectionResult res = projectState(model, data, scene.constraints, cd, *solver,
+                                                 projector, 0.0, q, v, impulse);
+  report.iterations = res.position.iterations;
+  report.projected = true;
+  if (!res.ok) {
+    // q and v are unchanged: name the worst row at the initial state.
+    evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
+    const Worst w = worstRow(cd, scene.v0);
+    std::ostringstream s;
+    s << scene.source << ": initial state could not be projected onto the constraints: "
+      << res.error << " (worst: " << describeRow(scene, cd, w.row)
+      << (w.gap ? " has gap " : " has velocity residual ") << w.value << ", tolerance " << tol
+      << ") after " << report.iterations << " Newton steps";
+    throw SceneError(s.str());
   }
-  // Velocities: the M-metric projection onto A v + b = 0 (the impulse that
-  // removes the violation with the least kinetic energy).
-  crba(model, data, q);
-  const Eigen::LDLT<MatX> M(data.M);
-  const MatX MinvAt = M.solve(cd.A.transpose());
-  const MatX S = cd.A * MinvAt;
-  const VecX r = cd.A * scene.v0 + cd.b;
-  VecX v = scene.v0 - MinvAt * Eigen::CompleteOrthogonalDecomposition<MatX>(S).solve(r);
   evaluateConstraints(model, data, scene.constraints, cd, 0.0, q, v);
   if (cd.singular) singular(scene, cd);
   report.velocity_residual = velocityResidual(cd, v);
   report.gap_residual = gapResidual(cd);
-  report.projected = true;
   notFinite(scene, report);
   if (report.velocity_residual > tol || report.gap_residual > tol) {
     const Worst w = worstRow(cd, v);
