@@ -1,4 +1,4 @@
-// Constrained-dynamics solve per step on the scaling scenes (examples/scenes):
+// Constrained-dynamics solve per step on the scaling scenes (tests/fixtures):
 // the O(n + m) tree solver against an unconstrained ABA on the same tree and
 // the dense KKT and Appell/Maggi references, for N = 8 … 1024 bodies.
 // Counters: ns_per_body (time per solve / bodies), bodies, rows.

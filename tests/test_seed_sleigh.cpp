@@ -177,7 +177,7 @@ TEST(SeedSleigh, AppellAccurateAtTheSecondKindEquilibrium) {
     q[2] = (k % 2 ? 1e-10 : 1e-3) * u(rng) + (k % 4 < 2 ? 0.0 : std::numbers::pi);
     VecX v(3);
     v << u(rng), u(rng), 2 * u(rng);
-    projectVelocityEuclidean(s.model, s.constraints, q, v);
+    projectVelocity(s.model, s.constraints, q, v);
     ConstrainedResult ref;
     evaluateConstraints(s.model, data, s.constraints, cd, 0, q, v);
     solvers[0]->solve(s.model, data, s.constraints, cd, q, v, tau, ref);

@@ -1,4 +1,4 @@
-// The tree solver on the scaling scenes (examples/scenes): N-trailer, wheeled
+// The tree solver on the scaling scenes (tests/fixtures): N-trailer, wheeled
 // snake, fleet, cars in a row — real knife-edge, rolling and sliding rows from
 // the contacts module, with their redundancy. After projecting v onto the
 // constraints (so redundant acceleration rows are consistent), v̇ and Aᵀλ

@@ -21,7 +21,7 @@
 // and the exact path is the centre turning uniformly about that axis:
 //   c(t) = O + Rz(Ω t)(c₀ − O),  O = c₀ + (e_z × v_c₀)/Ω.
 // The program checks this Ω, u₂ against the scene library's independent
-// angular-momentum balance (steadyDiskAxleRate, examples/scenes/rolling_disk.hpp).
+// angular-momentum balance (steadyDiskAxleRate, tests/fixtures/rolling_disk.hpp).
 // The spin case has no closed form: its reference is appell's Dormand–Prince at
 // tol 1e-14 with the dense multiplier (KKT) formulation — a different solver
 // from the tree solver the measured appell runs use — and the report states how
