@@ -1,8 +1,12 @@
-// Structural check of a URDF <robot> element, done on the XML so that every
-// message carries a line number. urdfdom reports its own errors only through
-// console_bridge, without lines, and silently accepts some broken trees (a
-// link with two parent joints keeps the last one), so the loader does not rely
-// on it for validation.
+// The one walk over a URDF <robot> element: every value is checked where it
+// is read, so every message carries a line number, and what is read is kept
+// (UrdfRobot) for buildRobot. No second parser sees the text: urdfdom, the
+// ROS parser, would re-parse it from the string (its only entry points),
+// reports errors without lines, and silently accepts some broken trees (a link
+// with two parent joints keeps the last one). The elements the loader does not
+// use but URDF 1.0 defines (materials, joint dynamics, safety controllers,
+// calibration) are still checked as urdfdom checks them, so a file this loader
+// accepts is a valid URDF for ROS tools too.
 #include "urdf/urdf_internal.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -31,8 +35,24 @@ const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
 
 namespace {
 
-void checkInertial(const XmlSource& src, const TiXmlElement* inertial) {
-  origin(src, inertial);
+// URDF 1.0 is the only version there is; urdfdom rejects any other, and
+// so does this loader. The attribute is "<major>.<minor>", both integers.
+void checkVersion(const XmlSource& src, const TiXmlElement* robot) {
+  const char* version = robot->Attribute("version");
+  if (!version) return;
+  const std::string v = version;
+  const auto dot = v.find('.');
+  auto integer = [](const std::string& s) {
+    return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (dot == std::string::npos || !integer(v.substr(0, dot)) || !integer(v.substr(dot + 1)))
+    fail(src, robot, "version \"" + v + "\" is not of the form <major>.<minor> (integers)");
+  if (std::stoul(v.substr(0, dot)) != 1 || std::stoul(v.substr(dot + 1)) != 0)
+    fail(src, robot, "version \"" + v + "\" is not supported (only URDF 1.0 is)");
+}
+
+Inertia readInertial(const XmlSource& src, const TiXmlElement* inertial) {
+  const SE3 X = origin(src, inertial);
   const TiXmlElement* mass = inertial->FirstChildElement("mass");
   if (!mass) fail(src, inertial, "missing <mass>");
   const double m = number(src, mass, "value");
@@ -58,81 +78,206 @@ void checkInertial(const XmlSource& src, const TiXmlElement* inertial) {
   if (d(0) + d(1) < d(2) - tol)
     fail(src, in, "principal moments " + s.str() +
                       " violate the triangle inequality I1 + I2 >= I3");
+  Inertia I;
+  I.mass = m;
+  I.com = X.p;
+  // The inertial frame may be rotated with respect to the link frame: the
+  // tensor given in it is R J Rᵀ in the link frame (about the same point).
+  I.inertia_com = X.R * J * X.R.transpose();
+  I.inertia_com = 0.5 * (I.inertia_com + I.inertia_com.transpose());
+  return I;
 }
 
-void checkGeometry(const XmlSource& src, const TiXmlElement* holder) {
-  origin(src, holder);
-  const TiXmlElement* g = holder->FirstChildElement("geometry");
-  if (!g) fail(src, holder, "missing <geometry>");
-  const TiXmlElement* shape = g->FirstChildElement();
-  if (!shape) fail(src, g, "empty <geometry>");
-  if (shape->NextSiblingElement()) fail(src, g, "more than one shape in <geometry>");
+// <color rgba> must be four numbers in [0, 1]; a top-level <material> must define a
+// colour or a texture (a <material> inside <visual> may only name one).
+void checkMaterial(const XmlSource& src, const TiXmlElement* material, bool top_level) {
+  text(src, material, "name");
+  const TiXmlElement* color = material->FirstChildElement("color");
+  if (color)
+    for (double c : numbers(src, color, "rgba", 4))
+      if (c < 0 || c > 1) fail(src, color, "colour components must lie in [0, 1]");
+  const TiXmlElement* texture = material->FirstChildElement("texture");
+  if (top_level && !color && !(texture && has(texture, "filename")))
+    fail(src, material, "a material needs a <color rgba> or a <texture filename>");
+}
+
+UrdfGeometry readGeometry(const XmlSource& src, const TiXmlElement* holder) {
+  UrdfGeometry out;
+  Geometry& g = out.geometry;
+  g.origin = origin(src, holder);
+  g.name = text(holder, "name", "");
+  const TiXmlElement* ge = holder->FirstChildElement("geometry");
+  if (!ge) fail(src, holder, "missing <geometry>");
+  const TiXmlElement* shape = ge->FirstChildElement();
+  if (!shape) fail(src, ge, "empty <geometry>");
+  if (shape->NextSiblingElement()) fail(src, ge, "more than one shape in <geometry>");
+  out.shape = shape;
   const std::string type = shape->Value();
-  auto positive = [&](const char* attr, double x) {
+  auto positive = [&](const char* attr) {
+    const double x = number(src, shape, attr);
     if (x <= 0) fail(src, shape, std::string("'") + attr + "' must be positive");
+    return x;
   };
   if (type == "box") {
-    const Vec3 s = vec3(src, shape, "size");
-    if (s.minCoeff() <= 0) fail(src, shape, "box sizes must be positive");
+    g.type = GeometryType::Box;
+    g.box_size = vec3(src, shape, "size");
+    if (g.box_size.minCoeff() <= 0) fail(src, shape, "box sizes must be positive");
   } else if (type == "cylinder") {
-    positive("radius", number(src, shape, "radius"));
-    positive("length", number(src, shape, "length"));
+    g.type = GeometryType::Cylinder;
+    g.radius = positive("radius");
+    g.length = positive("length");
   } else if (type == "sphere") {
-    positive("radius", number(src, shape, "radius"));
+    g.type = GeometryType::Sphere;
+    g.radius = positive("radius");
   } else if (type == "mesh") {
-    if (text(src, shape, "filename").empty()) fail(src, shape, "empty 'filename'");
-    const Vec3 sc = vec3(src, shape, "scale", Vec3::Ones());
-    if (sc.cwiseAbs().minCoeff() == 0) fail(src, shape, "'scale' has a zero component");
+    g.type = GeometryType::Mesh;
+    g.mesh_uri = text(src, shape, "filename");
+    if (g.mesh_uri.empty()) fail(src, shape, "empty 'filename'");
+    g.mesh_scale = vec3(src, shape, "scale", Vec3::Ones());
+    if (g.mesh_scale.cwiseAbs().minCoeff() == 0) fail(src, shape, "'scale' has a zero component");
   } else {
     fail(src, shape, "unsupported geometry <" + type + "> (supported: box, cylinder, sphere, mesh)");
   }
+  return out;
 }
 
-bool needsAxis(const std::string& type) {
-  return type == "revolute" || type == "continuous" || type == "prismatic" || type == "planar";
+UrdfLink readLink(const XmlSource& src, const TiXmlElement* l) {
+  UrdfLink link;
+  link.element = l;
+  link.name = text(src, l, "name");
+  if (link.name.empty()) fail(src, l, "empty link name");
+  if (const TiXmlElement* in = l->FirstChildElement("inertial")) {
+    if (in->NextSiblingElement("inertial")) fail(src, l, "more than one <inertial>");
+    link.inertia = readInertial(src, in);
+  }
+  for (const TiXmlElement* v = l->FirstChildElement("visual"); v; v = v->NextSiblingElement("visual")) {
+    link.visual.push_back(readGeometry(src, v));
+    if (const TiXmlElement* m = v->FirstChildElement("material")) checkMaterial(src, m, false);
+  }
+  for (const TiXmlElement* c = l->FirstChildElement("collision"); c;
+       c = c->NextSiblingElement("collision"))
+    link.collision.push_back(readGeometry(src, c));
+  return link;
+}
+
+// The URDF joint types, each with the Model's joint type (URDF has no ball joint).
+struct JointTypeName {
+  const char* name;
+  JointType type;
+};
+constexpr JointTypeName kJointTypes[] = {
+    {"fixed", JointType::Fixed},         {"revolute", JointType::Revolute},
+    {"continuous", JointType::Continuous}, {"prismatic", JointType::Prismatic},
+    {"planar", JointType::Planar},       {"floating", JointType::Floating}};
+
+JointType jointType(const XmlSource& src, const TiXmlElement* j) {
+  const std::string type = text(src, j, "type");
+  std::string known;
+  for (const JointTypeName& t : kJointTypes) {
+    if (type == t.name) return t.type;
+    known += (known.empty() ? "" : ", ") + std::string(t.name);
+  }
+  fail(src, j, "unsupported joint type '" + type + "' (supported: " + known + ")");
+}
+
+bool hasAxis(JointType type) { return type != JointType::Fixed && type != JointType::Floating; }
+
+// <dynamics>, <safety_controller> and <calibration> do not enter the model;
+// their numbers are still checked (URDF requires damping or friction in
+// <dynamics> and k_velocity in <safety_controller>).
+void checkUnusedJointElements(const XmlSource& src, const TiXmlElement* j) {
+  if (const TiXmlElement* d = j->FirstChildElement("dynamics")) {
+    if (!has(d, "damping") && !has(d, "friction"))
+      fail(src, d, "needs 'damping' or 'friction'");
+    number(src, d, "damping", 0.0);
+    number(src, d, "friction", 0.0);
+  }
+  if (const TiXmlElement* s = j->FirstChildElement("safety_controller")) {
+    number(src, s, "k_velocity");
+    for (const char* a : {"soft_lower_limit", "soft_upper_limit", "k_position"}) number(src, s, a, 0.0);
+  }
+  if (const TiXmlElement* c = j->FirstChildElement("calibration"))
+    for (const char* a : {"rising", "falling"}) number(src, c, a, 0.0);
+}
+
+UrdfJoint readJoint(const XmlSource& src, const TiXmlElement* j) {
+  UrdfJoint joint;
+  joint.element = j;
+  joint.name = text(src, j, "name");
+  if (joint.name.empty()) fail(src, j, "empty joint name");
+  joint.type = jointType(src, j);
+  const TiXmlElement* pe = j->FirstChildElement("parent");
+  const TiXmlElement* ce = j->FirstChildElement("child");
+  if (!pe) fail(src, j, "missing <parent>");
+  if (!ce) fail(src, j, "missing <child>");
+  joint.parent = text(src, pe, "link");
+  joint.child = text(src, ce, "link");
+  if (j->FirstChildElement("mimic"))
+    fail(src, j->FirstChildElement("mimic"),
+         "mimic joints are not supported (the coupling is a holonomic constraint this "
+         "loader does not create)");
+  joint.origin = origin(src, j);
+  if (const TiXmlElement* a = j->FirstChildElement("axis")) {
+    const Vec3 axis = vec3(src, a, "xyz");
+    if (hasAxis(joint.type)) {
+      if (axis.norm() < 1e-12) fail(src, a, "joint axis is zero");
+      joint.axis = axis;
+    }
+  }
+  const std::string type = text(src, j, "type");
+  if (const TiXmlElement* lim = j->FirstChildElement("limit")) {
+    // URDF: lower and upper default to 0; effort and velocity are required.
+    const double lo = number(src, lim, "lower", 0.0), hi = number(src, lim, "upper", 0.0);
+    joint.limits.effort = number(src, lim, "effort");
+    joint.limits.velocity = number(src, lim, "velocity");
+    if (joint.type != JointType::Continuous) {
+      if (lo > hi)
+        fail(src, lim, "lower limit " + std::to_string(lo) + " exceeds upper limit " +
+                           std::to_string(hi));
+      joint.limits.lower = lo;
+      joint.limits.upper = hi;
+    }
+  } else if (joint.type == JointType::Revolute || joint.type == JointType::Prismatic) {
+    fail(src, j, "a " + type + " joint needs a <limit> element (URDF requires it)");
+  }
+  checkUnusedJointElements(src, j);
+  return joint;
 }
 
 }  // namespace
 
-UrdfIndex checkUrdf(const XmlSource& src, const TiXmlElement* robot) {
-  UrdfIndex ix;
+UrdfRobot readUrdf(const XmlSource& src, const TiXmlElement* robot) {
+  UrdfRobot ix;
   if (text(robot, "name", "").empty()) fail(src, robot, "the robot has no name");
+  checkVersion(src, robot);
+
+  std::set<std::string> materials;
+  for (const TiXmlElement* m = robot->FirstChildElement("material"); m;
+       m = m->NextSiblingElement("material")) {
+    checkMaterial(src, m, true);
+    if (!materials.insert(m->Attribute("name")).second)
+      fail(src, m, "material name '" + std::string(m->Attribute("name")) + "' is used twice");
+  }
 
   for (const TiXmlElement* l = robot->FirstChildElement("link"); l;
        l = l->NextSiblingElement("link")) {
-    const std::string name = text(src, l, "name");
-    if (name.empty()) fail(src, l, "empty link name");
-    if (ix.links.count(name)) fail(src, l, "link name '" + name + "' is used twice");
-    ix.links[name] = l;
-    ix.link_order.push_back(name);
-    if (const TiXmlElement* in = l->FirstChildElement("inertial")) {
-      if (in->NextSiblingElement("inertial")) fail(src, l, "more than one <inertial>");
-      checkInertial(src, in);
-    }
-    for (const char* kind : {"visual", "collision"})
-      for (const TiXmlElement* v = l->FirstChildElement(kind); v; v = v->NextSiblingElement(kind))
-        checkGeometry(src, v);
+    UrdfLink link = readLink(src, l);
+    if (ix.links.count(link.name)) fail(src, l, "link name '" + link.name + "' is used twice");
+    ix.link_order.push_back(link.name);
+    ix.links.emplace(link.name, std::move(link));
   }
   if (ix.links.empty()) fail(src, robot, "no <link> elements");
   ix.has_world = ix.links.count("world") > 0;
 
-  static const std::set<std::string> kTypes = {"fixed",  "revolute", "continuous",
-                                               "prismatic", "planar", "floating"};
   for (const TiXmlElement* j = robot->FirstChildElement("joint"); j;
        j = j->NextSiblingElement("joint")) {
-    const std::string name = text(src, j, "name");
-    if (name.empty()) fail(src, j, "empty joint name");
-    if (ix.joints.count(name)) fail(src, j, "joint name '" + name + "' is used twice");
-    const std::string type = text(src, j, "type");
-    if (!kTypes.count(type))
-      fail(src, j, "unsupported joint type '" + type +
-                       "' (supported: fixed, revolute, continuous, prismatic, planar, floating)");
+    UrdfJoint joint = readJoint(src, j);
+    const std::string& name = joint.name;
+    const std::string& parent = joint.parent;
+    const std::string& child = joint.child;
     const TiXmlElement* pe = j->FirstChildElement("parent");
     const TiXmlElement* ce = j->FirstChildElement("child");
-    if (!pe) fail(src, j, "missing <parent>");
-    if (!ce) fail(src, j, "missing <child>");
-    const std::string parent = text(src, pe, "link");
-    const std::string child = text(src, ce, "link");
+    if (ix.joints.count(name)) fail(src, j, "joint name '" + name + "' is used twice");
     if (!ix.links.count(parent)) fail(src, pe, "parent link '" + parent + "' is not declared");
     if (!ix.links.count(child)) fail(src, ce, "child link '" + child + "' is not declared");
     if (parent == child) fail(src, j, "link '" + child + "' is its own parent");
@@ -140,30 +285,10 @@ UrdfIndex checkUrdf(const XmlSource& src, const TiXmlElement* robot) {
     if (auto it = ix.parent_joint.find(child); it != ix.parent_joint.end())
       fail(src, j, "link '" + child + "' has two parents (joints '" + it->second + "' and '" +
                        name + "')");
-    if (j->FirstChildElement("mimic"))
-      fail(src, j->FirstChildElement("mimic"),
-           "mimic joints are not supported (the coupling is a holonomic constraint this "
-           "loader does not create)");
-    origin(src, j);
-    if (const TiXmlElement* a = j->FirstChildElement("axis")) {
-      const Vec3 axis = vec3(src, a, "xyz");
-      if (needsAxis(type) && axis.norm() < 1e-12) fail(src, a, "joint axis is zero");
-    }
-    const TiXmlElement* lim = j->FirstChildElement("limit");
-    if (lim) {
-      const double lo = number(src, lim, "lower", 0.0), hi = number(src, lim, "upper", 0.0);
-      number(src, lim, "effort", 0.0);
-      number(src, lim, "velocity", 0.0);
-      if (type != "continuous" && lo > hi)
-        fail(src, lim, "lower limit " + std::to_string(lo) + " exceeds upper limit " +
-                           std::to_string(hi));
-    } else if (type == "revolute" || type == "prismatic") {
-      fail(src, j, "a " + type + " joint needs a <limit> element (URDF requires it)");
-    }
-    ix.joints[name] = j;
     ix.joint_order.push_back(name);
     ix.parent_joint[child] = name;
     ix.child_joints[parent].push_back(name);
+    ix.joints.emplace(name, std::move(joint));
   }
 
   // One tree: exactly one link without a parent, and every link reachable.
@@ -174,11 +299,11 @@ UrdfIndex checkUrdf(const XmlSource& src, const TiXmlElement* robot) {
     std::string others;
     for (const auto& r : roots)
       if (r != "world") others += (others.empty() ? "'" : ", '") + r + "'";
-    fail(src, ix.links.at(roots[roots[0] == "world" ? 1 : 0]),
+    fail(src, ix.links.at(roots[roots[0] == "world" ? 1 : 0]).element,
          "disconnected links: " + others + " not attached to 'world' (a URDF is one tree)");
   }
   if (roots.size() > 1)
-    fail(src, ix.links.at(roots[1]),
+    fail(src, ix.links.at(roots[1]).element,
          "disconnected links: '" + roots[0] + "' and '" + roots[1] +
              "' both have no parent joint (a URDF is one tree)");
   if (roots.empty()) fail(src, robot, "no root link: the joints form a cycle");
@@ -195,13 +320,12 @@ UrdfIndex checkUrdf(const XmlSource& src, const TiXmlElement* robot) {
     if (it == ix.child_joints.end()) continue;
     // Push in reverse so children come out in document order (depth first).
     for (auto j = it->second.rbegin(); j != it->second.rend(); ++j) {
-      const TiXmlElement* je = ix.joints.at(*j);
-      stack.push_back(je->FirstChildElement("child")->Attribute("link"));
+      stack.push_back(ix.joints.at(*j).child);
     }
   }
   for (const auto& n : ix.link_order)
     if (!seen.count(n))
-      fail(src, ix.links.at(n), "link '" + n + "' is not connected to the root '" + ix.root +
+      fail(src, ix.links.at(n).element, "link '" + n + "' is not connected to the root '" + ix.root +
                                     "' (its joints form a cycle)");
   return ix;
 }
