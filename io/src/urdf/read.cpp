@@ -47,7 +47,11 @@ void checkVersion(const XmlSource& src, const TiXmlElement* robot) {
   };
   if (dot == std::string::npos || !integer(v.substr(0, dot)) || !integer(v.substr(dot + 1)))
     fail(src, robot, "version \"" + v + "\" is not of the form <major>.<minor> (integers)");
-  if (std::stoul(v.substr(0, dot)) != 1 || std::stoul(v.substr(dot + 1)) != 0)
+  auto value = [](const std::string& s) {  // without leading zeros ("" is 0)
+    const auto k = s.find_first_not_of('0');
+    return k == std::string::npos ? std::string() : s.substr(k);
+  };
+  if (value(v.substr(0, dot)) != "1" || !value(v.substr(dot + 1)).empty())
     fail(src, robot, "version \"" + v + "\" is not supported (only URDF 1.0 is)");
 }
 
