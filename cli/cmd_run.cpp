@@ -1,15 +1,12 @@
-// appell run: simulate a scene, summarise it, write its trajectory.
+// appell run: the options of a run (run.hpp) from the command line, and its
+// summary printed.
 #include "commands.hpp"
-#include "contact_report.hpp"
 #include "plot.hpp"
 
-#include <appell/appell.hpp>
-#include <appell/output.hpp>
-#include <appell/simulator.hpp>
+#include <appell/run.hpp>
 
 #include <unistd.h>
 
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -40,13 +37,6 @@ Exit status: 0 success, 1 bad input, 2 usage, 3 the simulation failed (the
 summary says why and at what time; the trajectory up to there is written).
 )";
 
-bool passiveScene(const Scene& scene) {
-  if (scene.tau.size() && scene.tau.cwiseAbs().maxCoeff() > 0) return false;
-  for (const Support& s : scene.supports)
-    if (isMoving(s.motion)) return false;
-  return true;
-}
-
 class Progress {
  public:
   Progress(double total, bool enabled) : total_(total), enabled_(enabled && isatty(2)) {}
@@ -69,6 +59,69 @@ class Progress {
   int last_ = -1;
 };
 
+// The per-contact lines of the summary.
+void printContacts(std::ostream& out, const RunSummary& r) {
+  if (r.contacts.empty()) return;
+  out << "contacts (over " << r.samples << " samples):\n";
+  for (const ContactStats& e : r.contacts) {
+    out << "  " << std::left << std::setw(24) << e.name << std::right;
+    if (e.normal_row < 0) {
+      out << " (no normal row)\n";
+      continue;
+    }
+    out << std::setprecision(4) << " normal load " << e.min_normal << " … " << e.max_normal << " N";
+    if (!e.tangential_rows.empty()) {
+      out << ", friction demand max " << e.max_demand << " at t=" << e.t_max_demand;
+      if (std::isfinite(e.mu)) out << " (μ = " << e.mu << ")";
+    }
+    if (e.over_mu)
+      out << "  ⚠ exceeds μ in " << e.over_mu << " samples from t=" << e.first_slip << ": would slip";
+    if (e.pulling)
+      out << "  ⚠ normal pulls in " << e.pulling << " samples from t=" << e.first_pull
+          << ": would lift off";
+    out << "\n";
+  }
+}
+
+void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
+  const RunOptions& o = r.options;
+  const SimulatorCounters& c = r.counters;
+  const bool adaptive = o.integrator == IntegratorType::DormandPrince54;
+  out << std::setprecision(6) << "scene        " << scene.source << "\n"
+      << "model        " << scene.model.nbodies << " bodies, nv = " << scene.model.nv << ", "
+      << scene.constraints.size() << " contacts, " << scene.constraintRows() << " rows\n"
+      << "method       " << toString(o.integrator) << (adaptive ? " (tol " : " (dt ")
+      << (adaptive ? o.tol : o.dt) << "), formulation " << toString(o.formulation) << "\n"
+      << "simulated    " << r.time << " s in " << c.steps << " steps";
+  if (c.rejected) out << " (" << c.rejected << " rejected)";
+  out << ", " << c.evaluations << " dynamics solves\n"
+      << "wall time    " << r.wall_seconds << " s, "
+      << 1e6 * r.wall_seconds / std::max<long>(1, c.steps) << " µs per step\n"
+      << "energy       E0 = " << r.energy0 << " J, max |E − E0| = " << r.max_energy_deviation
+      << " J (" << r.relativeEnergyDeviation() << " relative)"
+      << (r.passive ? "" : "  [driven scene: energy is not conserved]") << "\n"
+      << "residuals    max |Av+b| = " << r.max_velocity_residual
+      << ", max |gap| = " << r.max_gap_residual
+      << (o.project_velocities ? "" : "  [projection off]") << "\n"
+      << "redundant    " << r.max_redundant << " rows\n";
+  out << "events       ";
+  int events = 0;
+  if (r.partition_changes) {
+    out << r.partition_changes << " re-choices of the velocity partition; ";
+    ++events;
+  }
+  if (r.flaggedContacts()) {
+    out << r.flaggedContacts() << " contacts flagged (below); ";
+    ++events;
+  }
+  if (!r.ok) {
+    out << "FAILED at t = " << r.time << " s: " << r.failure << " (last good state kept)";
+    ++events;
+  }
+  out << (events ? "\n" : "none\n");
+  printContacts(out, r);
+}
+
 }  // namespace
 
 int run(int argc, char** argv) {
@@ -87,114 +140,33 @@ int run(int argc, char** argv) {
   if (args.has("tol") && !args.has("integrator")) s.integrator = "dopri5";
   s.integrator = args.text("integrator", s.integrator);
   s.formulation = args.text("formulation", s.formulation);
-  const int every = args.integer("every", 1);
   if (args.has("plot") && !args.has("out")) throw UsageError("--plot plots the trajectory: give --out FILE.csv");
-  if (every < 1) throw UsageError("option --every must be at least 1");
-  IntegratorType itype;
-  Formulation form;
+  RunOptions options;
   try {
-    itype = integratorFromString(s.integrator);
-    form = formulationFromString(s.formulation);
+    options = runOptions(s);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
+  options.output_every = args.integer("every", 1);
+  if (options.output_every < 1) throw UsageError("option --every must be at least 1");
+  options.project_positions = options.project_velocities = !args.has("no-projection");
 
-  IntegratorOptions iopt;
-  iopt.rtol = s.tol;
-  iopt.atol = s.tol * 1e-2;
-  iopt.h_max = std::max(s.dt, s.duration / 20);
-  SimulatorOptions sopt;
-  sopt.project_positions = sopt.project_velocities = !args.has("no-projection");
-  Simulator sim(scene.model, scene.constraints, makeSolver(form, scene.model, scene.constraints),
-                itype, iopt, sopt);
-  if (scene.tau.size() == scene.model.nv) {
-    const VecX tau = scene.tau;
-    sim.setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
-  }
-  sim.setState(0.0, scene.q0, scene.v0);  // after the forces: the t = 0 reactions include them
-
+  Progress progress(options.duration, !args.has("quiet"));
+  auto on_step = [&](const Simulator& sim) { progress.update(sim.time()); };
+  RunSummary summary;
   std::ofstream csv;
   std::unique_ptr<TrajectoryWriter> writer;
-  std::vector<ContactFrame> frames(scene.constraints.size());
-  auto record = [&] {
-    if (!writer) return;
-    for (size_t k = 0; k < frames.size(); ++k) frames[k] = sim.contactFrame(static_cast<int>(k));
-    writer->write(sim.time(), sim.q(), sim.v(), sim.energy(),
-                  std::max(sim.velocityResidual(), sim.gapResidual()), frames, sim.lambda());
-  };
   if (args.has("out")) {
     csv.open(args.text("out"));
     if (!csv) throw std::runtime_error("cannot write '" + args.text("out") + "'");
     writer = std::make_unique<TrajectoryWriter>(csv, scene);
+    summary = runScene(scene, options, *writer, on_step);
+  } else {
+    summary = runScene(scene, options, {}, on_step);
   }
-
-  ContactReport contacts(scene);
-  const double E0 = sim.energy();
-  const double energy_scale = std::max({std::abs(E0), sim.kineticEnergy(), 1e-12});
-  double max_energy_dev = 0, max_vel_res = sim.velocityResidual(), max_gap_res = sim.gapResidual();
-  int max_redundant = sim.redundantRows();
-  contacts.sample(sim.time(), sim.lambda());
-  record();
-
-  Progress progress(s.duration, !args.has("quiet"));
-  const auto wall0 = std::chrono::steady_clock::now();
-  StepStatus status;
-  double h = s.dt;
-  long step = 0;
-  while (sim.time() < s.duration * (1 - 1e-12)) {
-    const double h_try = std::min(h, s.duration - sim.time());
-    status = sim.step(h_try);
-    if (!status.ok) break;
-    ++step;
-    if (itype == IntegratorType::DormandPrince54) h = status.h_next;
-    max_energy_dev = std::max(max_energy_dev, std::abs(sim.energy() - E0));
-    max_vel_res = std::max(max_vel_res, sim.velocityResidual());
-    max_gap_res = std::max(max_gap_res, sim.gapResidual());
-    max_redundant = std::max(max_redundant, sim.redundantRows());
-    contacts.sample(sim.time(), sim.lambda());
-    if (step % every == 0) record();
-    progress.update(sim.time());
-  }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   progress.done();
-  if (writer && step % every != 0) record();
 
-  const SimulatorCounters& c = sim.counters();
-  std::cout << std::setprecision(6) << "scene        " << scene.source << "\n"
-            << "model        " << scene.model.nbodies << " bodies, nv = " << scene.model.nv << ", "
-            << scene.constraints.size() << " contacts, " << scene.constraintRows() << " rows\n"
-            << "method       " << toString(itype)
-            << (itype == IntegratorType::DormandPrince54 ? " (tol " : " (dt ")
-            << (itype == IntegratorType::DormandPrince54 ? s.tol : s.dt)
-            << "), formulation " << toString(form) << "\n"
-            << "simulated    " << sim.time() << " s in " << c.steps << " steps";
-  if (c.rejected) std::cout << " (" << c.rejected << " rejected)";
-  std::cout << ", " << c.evaluations << " dynamics solves\n"
-            << "wall time    " << wall << " s, " << 1e6 * wall / std::max<long>(1, c.steps)
-            << " µs per step\n"
-            << "energy       E0 = " << E0 << " J, max |E − E0| = " << max_energy_dev << " J ("
-            << max_energy_dev / energy_scale << " relative)"
-            << (passiveScene(scene) ? "" : "  [driven scene: energy is not conserved]") << "\n"
-            << "residuals    max |Av+b| = " << max_vel_res << ", max |gap| = " << max_gap_res
-            << (sopt.project_velocities ? "" : "  [projection off]") << "\n"
-            << "redundant    " << max_redundant << " rows\n";
-  std::cout << "events       ";
-  int events = 0;
-  if (sim.partitionChanges()) {
-    std::cout << sim.partitionChanges() << " re-choices of the velocity partition; ";
-    ++events;
-  }
-  if (contacts.flagged()) {
-    std::cout << contacts.flagged() << " contacts flagged (below); ";
-    ++events;
-  }
-  if (!status.ok) {
-    std::cout << "FAILED at t = " << sim.time() << " s: " << status.message
-              << " (last good state kept)";
-    ++events;
-  }
-  std::cout << (events ? "\n" : "none\n");
-  contacts.print(std::cout);
+  printSummary(std::cout, scene, summary);
   if (writer) std::cout << "trajectory   " << args.text("out") << " (" << writer->samples() << " rows, "
                         << writer->columns().size() << " columns)\n";
   if (args.has("plot")) {
@@ -202,7 +174,7 @@ int run(int argc, char** argv) {
     for (const std::string& png : writePlots(args.text("out"), defaultPlotDir(args.text("out")), &scene))
       std::cout << "plot         " << png << "\n";
   }
-  return status.ok ? 0 : 3;
+  return summary.ok ? 0 : 3;
 }
 
 }  // namespace appell::cli

@@ -1,5 +1,6 @@
 #include "plot.hpp"
 
+#include <appell/constraint.hpp>
 #include <appell/trajectory_reader.hpp>
 
 #include <sys/wait.h>
@@ -83,7 +84,9 @@ struct ContactColumns {
 };
 
 /// Contacts in CSV order: each "point:<c>.x" column opens one; its rows are
-/// the "lambda:<c>.<label>" columns (output.hpp).
+/// the "lambda:<c>.<label>" columns (output.hpp). A file read back has only
+/// the labels; they are the row kinds' names (toString(RowKind)), so the
+/// normal and friction rows are found through that one table.
 std::vector<ContactColumns> contactColumns(const TrajectoryTable& table) {
   std::vector<ContactColumns> out;
   for (size_t i = 0; i < table.columns.size(); ++i) {
@@ -93,9 +96,9 @@ std::vector<ContactColumns> contactColumns(const TrajectoryTable& table) {
       c.name = col.substr(6, col.size() - 8);
       c.px = static_cast<int>(i);
       c.py = table.find("point:" + c.name + ".y");
-      c.normal = table.find("lambda:" + c.name + ".normal");
-      for (const char* label : {"tangent1", "tangent2", "lateral"}) {
-        const int k = table.find("lambda:" + c.name + "." + label);
+      c.normal = table.find("lambda:" + c.name + "." + toString(RowKind::Normal));
+      for (RowKind kind : {RowKind::Tangent1, RowKind::Tangent2, RowKind::Lateral}) {
+        const int k = table.find("lambda:" + c.name + "." + toString(kind));
         if (k >= 0) c.tangential.push_back(k);
       }
       out.push_back(c);

@@ -59,6 +59,11 @@ TEST(CustomConstraint, RowsPassThroughAndAccelerationTermIsConsistent) {
   EXPECT_TRUE(c->jointSpace());
   EXPECT_EQ(c->rows(), 2);
   EXPECT_EQ(c->rowLabel(1), "height");
+  // A user's rows are Custom; their labels are the user's, or "custom<k>".
+  EXPECT_EQ(c->rowKind(1), RowKind::Custom);
+  CustomRows unlabelled = oscillatorRows();
+  unlabelled.labels.clear();
+  EXPECT_EQ(CustomConstraint(unlabelled).rowLabel(1), "custom1");
   EXPECT_TRUE(c->holonomic(1));
   EXPECT_FALSE(c->holonomic(0));
   const ConstraintList list{c};
@@ -229,6 +234,13 @@ TEST(ContactFactory, KindsAndLabels) {
   const auto r = makeContact(ContactKind::RollingWithoutSpin, 0, Sphere{0.1, Vec3::Zero()}, g);
   EXPECT_EQ(r->rows(), 4);
   EXPECT_EQ(r->rowLabel(3), "spin");
+  // The rows' meaning is data; the labels (CSV column names) derive from it.
+  const RowKind rolling[] = {RowKind::Tangent1, RowKind::Tangent2, RowKind::Normal, RowKind::Spin};
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(r->rowKind(k), rolling[k]);
+    EXPECT_EQ(r->rowLabel(k), toString(rolling[k]));
+    EXPECT_EQ(r->holonomic(k), rolling[k] == RowKind::Normal);
+  }
   EXPECT_TRUE(r->holonomic(2));
   EXPECT_FALSE(r->holonomic(3));
   ContactOptions o;
@@ -236,6 +248,10 @@ TEST(ContactFactory, KindsAndLabels) {
   const auto k = makeContact(ContactKind::KnifeEdge, 0, PointShape{}, g, o);
   EXPECT_EQ(k->rows(), 2);
   EXPECT_EQ(k->rowLabel(0), "lateral");
+  EXPECT_EQ(k->rowKind(0), RowKind::Lateral);
+  EXPECT_EQ(k->rowKind(1), RowKind::Normal);
+  EXPECT_TRUE(isTangential(RowKind::Lateral));
+  EXPECT_FALSE(isTangential(RowKind::Spin));
   EXPECT_TRUE(k->bladeDirection().isApprox(Vec3::UnitY()));
   std::string why;
   EXPECT_FALSE(canRoll(Box{}, &why));

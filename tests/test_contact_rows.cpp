@@ -263,15 +263,17 @@ TEST(ContactRows, RowsAreRelativeVelocitiesAndVanishInContact) {
           const Vec3 rel = V.tail<3>() + V.head<3>().cross(x) - S.pointVelocity(x);
           const Vec3 relw = V.head<3>() - S.V.head<3>();
           for (int k = 0; k < c->rows(); ++k) {
-            const std::string label = c->rowLabel(k);
             const double r = blk.Wa.row(k).dot(V) + blk.b[k];
-            double expect;
-            if (label == "tangent1") expect = g.t1.dot(rel);
-            else if (label == "tangent2") expect = g.t2.dot(rel);
-            else if (label == "normal") expect = n.dot(rel);
-            else if (label == "spin") expect = n.dot(relw);
-            else expect = lateral.dot(rel);
-            EXPECT_NEAR(r, expect, 1e-12) << where << " " << label;
+            double expect = std::nan("");
+            switch (c->rowKind(k)) {
+              case RowKind::Tangent1: expect = g.t1.dot(rel); break;
+              case RowKind::Tangent2: expect = g.t2.dot(rel); break;
+              case RowKind::Normal: expect = n.dot(rel); break;
+              case RowKind::Spin: expect = n.dot(relw); break;
+              case RowKind::Lateral: expect = lateral.dot(rel); break;
+              case RowKind::Custom: ADD_FAILURE() << where << ": a contact row of kind custom"; break;
+            }
+            EXPECT_NEAR(r, expect, 1e-12) << where << " " << c->rowLabel(k);
           }
           // A velocity that satisfies the contact: rows vanish.
           Vec3 w = randomVec(rng, 2.0);

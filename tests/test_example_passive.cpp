@@ -79,7 +79,7 @@ int normalRow(const Scene& s, int contact) {
   int offset = 0;
   for (int c = 0; c < contact; ++c) offset += s.constraints[c]->rows();
   for (int r = 0; r < s.constraints[contact]->rows(); ++r)
-    if (s.constraints[contact]->rowLabel(r) == "normal") return offset + r;
+    if (s.constraints[contact]->rowKind(r) == RowKind::Normal) return offset + r;
   return -1;
 }
 

@@ -82,7 +82,7 @@ std::vector<int> normalRows(const Scene& s) {
   int offset = 0;
   for (const auto& c : s.constraints) {
     for (int r = 0; r < c->rows(); ++r)
-      if (c->rowLabel(r) == "normal") rows.push_back(offset + r);
+      if (c->rowKind(r) == RowKind::Normal) rows.push_back(offset + r);
     offset += c->rows();
   }
   return rows;

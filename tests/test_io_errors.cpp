@@ -90,12 +90,18 @@ TEST(IoErrors, UnsupportedJointType) {
   expectError("unsupported_joint.urdf", 5, {"<joint name=\"shoulder\">", "unsupported joint type 'spherical'"});
 }
 
-TEST(IoErrors, UrdfdomRejectionIsWrappedWithTheFileName) {
-  // A malformed version attribute is rejected by urdfdom itself (the
-  // loader's own check does not look at it); urdfdom's reason reaches the user.
-  const std::string msg = errorOf("urdfdom_rejects.urdf");
-  EXPECT_EQ(msg.rfind(kBad + "urdfdom_rejects.urdf: urdfdom rejected the file: ", 0), 0u) << msg;
-  EXPECT_NE(msg.find("Version attribute is not an integer"), std::string::npos) << msg;
+TEST(IoErrors, UrdfVersionOtherThan1_0) {
+  // URDF 1.0 is the only version; a malformed or other version is rejected
+  // (as urdfdom, the ROS parser, rejects it), with the line of <robot>.
+  expectError("bad_version.urdf", 2, {"<robot name=\"r\">", "version \"1.x\"", "<major>.<minor>"});
+}
+
+TEST(IoErrors, ElementsTheModelIgnoresAreStillChecked) {
+  // A URDF this loader accepts is a URDF ROS tools accept: <limit> needs
+  // effort and velocity, <dynamics> damping or friction, a material a colour.
+  expectError("limit_no_effort.urdf", 8, {"<limit>", "missing attribute 'effort'"});
+  expectError("dynamics_empty.urdf", 9, {"<dynamics>", "needs 'damping' or 'friction'"});
+  expectError("material_undefined.urdf", 3, {"<material name=\"grey\">", "<color rgba>"});
 }
 
 TEST(IoErrors, ContactOnAShapeThatCannotRoll) {

@@ -82,6 +82,7 @@ TEST(IoScene, SleighKnifeEdgeAndSlidingFeet) {
   EXPECT_TRUE(s.contacts[0].blade_direction.isApprox(Vec3(2, 0, 0)));
   EXPECT_EQ(s.constraints[0]->rows(), 2);
   EXPECT_EQ(s.constraints[0]->rowLabel(0), "lateral");
+  EXPECT_EQ(s.constraints[0]->rowKind(0), RowKind::Lateral);
   EXPECT_EQ(s.contacts[1].kind, ContactKind::Sliding);
   EXPECT_TRUE(as<PointShape>(s.contacts[1].shape).position.isApprox(Vec3(0.6, 0.2, 0)));
   EXPECT_EQ(s.constraints[1]->rows(), 1);

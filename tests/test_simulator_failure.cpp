@@ -25,6 +25,7 @@ class ContradictoryWhen final : public Constraint {
   const std::string& name() const override { return name_; }
   int rows() const override { return 2; }
   int bodyA() const override { return 0; }
+  RowKind rowKind(int) const override { return RowKind::Custom; }
   std::string rowLabel(int k) const override { return k == 0 ? "first" : "second"; }
   bool holonomic(int) const override { return false; }
   void evaluate(const Model&, const Data& data, double, const VecX&, const VecX&,

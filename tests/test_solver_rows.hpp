@@ -37,6 +37,7 @@ class BodyRows final : public Constraint {
   const std::string& name() const override { return name_; }
   int rows() const override { return static_cast<int>(w_.size()); }
   int bodyA() const override { return body_; }
+  RowKind rowKind(int) const override { return RowKind::Custom; }
   std::string rowLabel(int k) const override { return "r" + std::to_string(k); }
   bool holonomic(int) const override { return false; }
   void evaluate(const Model&, const Data& data, double, const VecX&, const VecX&,
@@ -65,9 +66,9 @@ class RollingBall final : public Constraint {
   const std::string& name() const override { return name_; }
   int rows() const override { return 3; }
   int bodyA() const override { return body_; }
-  std::string rowLabel(int k) const override {
-    static const char* labels[] = {"tangent1", "tangent2", "normal"};
-    return labels[k];
+  RowKind rowKind(int k) const override {
+    static constexpr RowKind kinds[] = {RowKind::Tangent1, RowKind::Tangent2, RowKind::Normal};
+    return kinds[k];
   }
   bool holonomic(int k) const override { return k == 2; }
   void evaluate(const Model&, const Data& data, double, const VecX&, const VecX&,

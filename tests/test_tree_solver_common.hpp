@@ -32,6 +32,7 @@ class LocalRows : public Constraint {
   int rows() const override { return static_cast<int>(Ka_.rows()); }
   int bodyA() const override { return a_; }
   int bodyB() const override { return b_; }
+  RowKind rowKind(int) const override { return RowKind::Custom; }
   std::string rowLabel(int k) const override { return "row" + std::to_string(k); }
   bool holonomic(int) const override { return false; }
   void evaluate(const Model&, const Data& data, double, const VecX&, const VecX&,
@@ -67,6 +68,7 @@ class JointRows : public Constraint {
   int rows() const override { return static_cast<int>(A_.rows()); }
   int bodyA() const override { return -1; }
   bool jointSpace() const override { return true; }
+  RowKind rowKind(int) const override { return RowKind::Custom; }
   std::string rowLabel(int k) const override { return "joint" + std::to_string(k); }
   bool holonomic(int) const override { return false; }
   void evaluate(const Model&, const Data&, double, const VecX&, const VecX&,

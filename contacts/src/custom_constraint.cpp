@@ -24,7 +24,7 @@ CustomConstraint::CustomConstraint(CustomRows spec) : spec_(std::move(spec)) {
 }
 
 std::string CustomConstraint::rowLabel(int k) const {
-  return spec_.labels.empty() ? "custom" + std::to_string(k) : spec_.labels[k];
+  return spec_.labels.empty() ? Constraint::rowLabel(k) : spec_.labels[k];
 }
 
 bool CustomConstraint::holonomic(int k) const {

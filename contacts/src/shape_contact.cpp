@@ -119,28 +119,20 @@ ShapeContact::ShapeContact(ContactKind kind, int body, Shape shape, Support supp
   }
 }
 
-std::string ShapeContact::rowLabel(int k) const {
+RowKind ShapeContact::rowKind(int k) const {
+  static constexpr RowKind rolling[] = {RowKind::Tangent1, RowKind::Tangent2, RowKind::Normal,
+                                        RowKind::Spin};
   switch (kind_) {
     case ContactKind::Rolling:
-    case ContactKind::RollingWithoutSpin: {
-      static const char* labels[] = {"tangent1", "tangent2", "normal", "spin"};
-      return labels[k];
-    }
-    case ContactKind::KnifeEdge: return k == 0 ? "lateral" : "normal";
-    case ContactKind::Sliding: return "normal";
+    case ContactKind::RollingWithoutSpin: return rolling[k];
+    case ContactKind::KnifeEdge: return k == 0 ? RowKind::Lateral : RowKind::Normal;
+    case ContactKind::Sliding: return RowKind::Normal;
   }
-  return "?";
+  return RowKind::Custom;
 }
 
-bool ShapeContact::holonomic(int k) const {
-  switch (kind_) {
-    case ContactKind::Rolling:
-    case ContactKind::RollingWithoutSpin: return k == 2;
-    case ContactKind::KnifeEdge: return k == 1;
-    case ContactKind::Sliding: return k == 0;
-  }
-  return false;
-}
+// The normal row is ġ for the signed gap g; the others are velocity rows.
+bool ShapeContact::holonomic(int k) const { return rowKind(k) == RowKind::Normal; }
 
 void ShapeContact::reserve(const Model& model, RowBlock& block) const {
   if (support_.body >= model.nbodies)

@@ -54,7 +54,7 @@ class ShapeContact : public Constraint {
   int bodyA() const override { return body_; }
   /// The body carrying the support, or −1 (world).
   int bodyB() const override { return support_.body; }
-  std::string rowLabel(int k) const override;
+  RowKind rowKind(int k) const override;
   bool holonomic(int k) const override;
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,

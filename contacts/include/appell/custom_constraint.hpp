@@ -43,6 +43,9 @@ class CustomConstraint : public Constraint {
   const std::string& name() const override { return spec_.name; }
   int rows() const override { return spec_.rows; }
   int bodyA() const override { return spec_.body; }
+  /// Custom: the rows' meaning is the user's (their labels name it).
+  RowKind rowKind(int) const override { return RowKind::Custom; }
+  /// The user's label, or "custom<k>".
   std::string rowLabel(int k) const override;
   bool holonomic(int k) const override;
   bool jointSpace() const override { return true; }

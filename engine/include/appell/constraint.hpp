@@ -12,6 +12,11 @@
 //
 // Rows that are not naturally body-local (user-supplied rows over v) say
 // jointSpace() and give A, b and Ȧv + ḃ over the generalized velocities.
+//
+// Each row says what it means (RowKind): λ of a row with direction t is the
+// force along t on the body, so the normal row carries the normal load and
+// tangent and lateral rows the friction force; reports find rows by kind,
+// never by their label.
 #pragma once
 
 #include <appell/data.hpp>
@@ -22,6 +27,20 @@ namespace appell {
 
 using RowMatrix6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 6, 6>;
 using RowVector6 = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+
+/// What a row constrains. Contact rows (contacts.hpp): the relative velocity
+/// of the contact points along the normal, the two tangents or the knife
+/// edge's lateral direction, or the relative spin about the normal. Custom:
+/// anything else (user rows, joint-space rows).
+enum class RowKind { Normal, Tangent1, Tangent2, Lateral, Spin, Custom };
+
+/// "normal", "tangent1", "tangent2", "lateral", "spin", "custom": the row
+/// labels of messages and of the CSV columns lambda:<constraint>.<label>.
+const char* toString(RowKind kind);
+/// Rows whose force lies in the contact's tangent plane (friction).
+inline bool isTangential(RowKind kind) {
+  return kind == RowKind::Tangent1 || kind == RowKind::Tangent2 || kind == RowKind::Lateral;
+}
 
 /// Geometric description of a contact at the current state, for reports.
 struct ContactFrame {
@@ -54,8 +73,11 @@ class Constraint {
   /// Body the rows act on, and the second body (−1: the world / none).
   virtual int bodyA() const = 0;
   virtual int bodyB() const { return -1; }
-  /// Label of row k, e.g. "normal", "tangent1", "tangent2", "spin", "lateral".
-  virtual std::string rowLabel(int k) const = 0;
+  /// What row k constrains.
+  virtual RowKind rowKind(int k) const = 0;
+  /// Label of row k for messages and CSV columns: toString(rowKind(k)), and
+  /// "custom<k>" for Custom rows unless the constraint names them.
+  virtual std::string rowLabel(int k) const;
   /// Row k is ġ for a gap g(q, t) — the position projection drives g to 0.
   virtual bool holonomic(int k) const = 0;
   /// Rows given over v (A_joint …) rather than as body covectors.

@@ -1,4 +1,5 @@
-// The loader's entry points: read, check, build — all or nothing.
+// The loader's entry points: one parse of the text, one read of the URDF and
+// of the <appell> block from that DOM, then the build — all or nothing.
 #include "scene/block.hpp"
 
 #include <filesystem>
@@ -12,9 +13,9 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   const io::XmlSource src{name};
   TiXmlDocument doc;
   const TiXmlElement* robot = io::parseDocument(src, doc, xml);
-  const io::UrdfIndex index = io::checkUrdf(src, robot);
+  const io::UrdfRobot urdf = io::readUrdf(src, robot);
   const io::AppellBlock block = io::parseAppellBlock(src, robot, base_dir, options);
-  io::Robot parsed = io::buildRobot(src, index, xml, base_dir, options, block.gravity);
+  io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity);
   Scene scene;
   scene.model = std::move(parsed.model);
   scene.geometry = std::move(parsed.geometry);

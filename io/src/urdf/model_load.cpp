@@ -30,12 +30,12 @@ Model loadUrdfModel(const std::string& path, const LoadOptions& options) {
   const io::XmlSource src{path};
   TiXmlDocument doc;
   const TiXmlElement* robot = io::parseDocument(src, doc, xml);
-  const io::UrdfIndex index = io::checkUrdf(src, robot);
+  const io::UrdfRobot urdf = io::readUrdf(src, robot);
   // Only the gravity of the scene block matters for the model.
   Vec3 gravity(0, 0, -9.81);
   if (const TiXmlElement* block = robot->FirstChildElement("appell"))
     if (const TiXmlElement* g = block->FirstChildElement("gravity")) gravity = io::vec3(src, g, "xyz");
-  return io::buildRobot(src, index, xml, io::folderOf(path), options, gravity).model;
+  return io::buildRobot(src, urdf, io::folderOf(path), options, gravity).model;
 }
 
 }  // namespace appell

@@ -1,4 +1,10 @@
 // Private pieces of the URDF loader shared between its source files.
+//
+// The URDF is parsed once, by TinyXML, into one DOM that every stage reads:
+// readUrdf (read.cpp) walks the <robot> element once, checking each value as
+// it reads it, so every message carries a line number; buildRobot (model.cpp)
+// turns what it read into the Model and the link geometry; the <appell> block
+// (scene/block.cpp) reads its own child of the same DOM.
 #pragma once
 
 #include <appell/urdf.hpp>
@@ -11,10 +17,36 @@
 
 namespace appell::io {
 
-/// What the structural check of the <robot> element found: every link and
-/// joint element by name, in document order, and the tree.
-struct UrdfIndex {
-  std::map<std::string, const TiXmlElement*> links, joints;
+/// One <visual> or <collision> element as read: the geometry with its mesh
+/// not yet resolved, and the shape element (<box>, <mesh>, …) for messages.
+struct UrdfGeometry {
+  const TiXmlElement* shape = nullptr;
+  Geometry geometry;
+};
+
+struct UrdfLink {
+  const TiXmlElement* element = nullptr;
+  std::string name;
+  /// From <inertial>: the inertia tensor rotated into the link frame
+  /// (I_link = R I Rᵀ about the centre of mass). Zero mass without <inertial>.
+  Inertia inertia;
+  std::vector<UrdfGeometry> visual, collision;  ///< document order
+};
+
+struct UrdfJoint {
+  const TiXmlElement* element = nullptr;
+  std::string name, parent, child;
+  JointType type = JointType::Fixed;
+  SE3 origin;                      ///< joint frame in the parent link's frame
+  Vec3 axis = Vec3::UnitX();       ///< URDF's default when <axis> is absent
+  JointLimits limits;              ///< infinite without <limit>
+};
+
+/// What readUrdf found: every link and joint by name, in document order, and
+/// the tree.
+struct UrdfRobot {
+  std::map<std::string, UrdfLink> links;
+  std::map<std::string, UrdfJoint> joints;
   std::vector<std::string> link_order, joint_order;
   std::map<std::string, std::string> parent_joint;          ///< child link → joint
   std::map<std::string, std::vector<std::string>> child_joints;  ///< link → joints, document order
@@ -24,10 +56,12 @@ struct UrdfIndex {
   std::vector<std::string> body_order;
 };
 
-/// Checks the <robot> element before urdfdom sees it, with line numbers:
-/// names, numbers (finite), masses, inertia tensors, geometry sizes, joint
-/// types, axes, limits, and that the links form one tree. Throws SceneError.
-UrdfIndex checkUrdf(const XmlSource& src, const TiXmlElement* robot);
+/// Reads the <robot> element, checking as it goes: the version, names,
+/// numbers (finite), masses, inertia tensors, geometry sizes, joint types,
+/// axes, limits, the elements the loader does not use but URDF defines
+/// (materials, joint dynamics, safety controllers, calibration), and that the
+/// links form one tree. Throws SceneError "file:line: <element>: reason".
+UrdfRobot readUrdf(const XmlSource& src, const TiXmlElement* robot);
 
 /// A parsed robot: the model and the geometry of each body.
 struct Robot {
@@ -35,9 +69,10 @@ struct Robot {
   std::vector<LinkGeometry> geometry;
 };
 
-/// Builds the model through urdfdom from the same text (after checkUrdf).
-Robot buildRobot(const XmlSource& src, const UrdfIndex& index, const std::string& xml,
-                 const std::string& base_dir, const LoadOptions& options, const Vec3& gravity);
+/// Builds the model and the link geometry (meshes resolved and, if the
+/// options say so, loaded) from what readUrdf read.
+Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string& base_dir,
+                 const LoadOptions& options, const Vec3& gravity);
 
 /// Whole file as a string; SceneError if it cannot be read.
 std::string readFile(const std::string& path);

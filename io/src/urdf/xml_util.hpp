@@ -1,5 +1,5 @@
 // Strict reading of XML attributes with messages that name the file, the
-// line and the element (TinyXML 1, the parser urdfdom itself uses on Debian).
+// line and the element (TinyXML 1: the one parser of the URDF).
 #pragma once
 
 #include <appell/scene.hpp>

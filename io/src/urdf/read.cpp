@@ -1,0 +1,337 @@
+// The one walk over a URDF <robot> element: every value is checked where it
+// is read, so every message carries a line number, and what is read is kept
+// (UrdfRobot) for buildRobot. No second parser sees the text: urdfdom, the
+// ROS parser, would re-parse it from the string (its only entry points),
+// reports errors without lines, and silently accepts some broken trees (a link
+// with two parent joints keeps the last one). The elements the loader does not
+// use but URDF 1.0 defines (materials, joint dynamics, safety controllers,
+// calibration) are still checked as urdfdom checks them, so a file this loader
+// accepts is a valid URDF for ROS tools too.
+#include "urdf/urdf_internal.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace appell::io {
+
+const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
+                                  const std::string& xml) {
+  doc.Parse(xml.c_str(), nullptr, TIXML_ENCODING_UTF8);
+  if (doc.Error()) {
+    std::string where = src.file;
+    if (doc.ErrorRow() > 0)
+      where += ":" + std::to_string(doc.ErrorRow()) + ":" + std::to_string(doc.ErrorCol());
+    throw SceneError(where + ": malformed XML: " + doc.ErrorDesc());
+  }
+  const TiXmlElement* robot = doc.RootElement();
+  if (!robot) fail(src, "malformed XML: no root element");
+  if (std::string(robot->Value()) != "robot")
+    fail(src, robot, "the root element must be <robot>");
+  return robot;
+}
+
+namespace {
+
+// URDF 1.0 is the only version there is; urdfdom rejects any other, and
+// so does this loader. The attribute is "<major>.<minor>", both integers.
+void checkVersion(const XmlSource& src, const TiXmlElement* robot) {
+  const char* version = robot->Attribute("version");
+  if (!version) return;
+  const std::string v = version;
+  const auto dot = v.find('.');
+  auto integer = [](const std::string& s) {
+    return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (dot == std::string::npos || !integer(v.substr(0, dot)) || !integer(v.substr(dot + 1)))
+    fail(src, robot, "version \"" + v + "\" is not of the form <major>.<minor> (integers)");
+  auto value = [](const std::string& s) {  // without leading zeros ("" is 0)
+    const auto k = s.find_first_not_of('0');
+    return k == std::string::npos ? std::string() : s.substr(k);
+  };
+  if (value(v.substr(0, dot)) != "1" || !value(v.substr(dot + 1)).empty())
+    fail(src, robot, "version \"" + v + "\" is not supported (only URDF 1.0 is)");
+}
+
+Inertia readInertial(const XmlSource& src, const TiXmlElement* inertial) {
+  const SE3 X = origin(src, inertial);
+  const TiXmlElement* mass = inertial->FirstChildElement("mass");
+  if (!mass) fail(src, inertial, "missing <mass>");
+  const double m = number(src, mass, "value");
+  if (m <= 0)
+    fail(src, mass, "mass must be positive, got " + std::to_string(m) +
+                        " (leave out <inertial> for a massless link)");
+  const TiXmlElement* in = inertial->FirstChildElement("inertia");
+  if (!in) fail(src, inertial, "missing <inertia>");
+  const char* names[6] = {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"};
+  double c[6];
+  for (int k = 0; k < 6; ++k) c[k] = number(src, in, names[k]);
+  Mat3 J;
+  J << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
+  // A rotational inertia about the centre of mass is positive definite and
+  // its principal moments satisfy I₁ + I₂ ≥ I₃ (each moment is a sum of two
+  // second moments of the mass distribution); otherwise no body has it.
+  const Vec3 d = Eigen::SelfAdjointEigenSolver<Mat3>(J).eigenvalues();
+  std::ostringstream s;
+  s << d(0) << ", " << d(1) << ", " << d(2);
+  if (d.minCoeff() <= 0)
+    fail(src, in, "inertia tensor is not positive definite (principal moments " + s.str() + ")");
+  const double tol = 1e-12 * d.cwiseAbs().maxCoeff();
+  if (d(0) + d(1) < d(2) - tol)
+    fail(src, in, "principal moments " + s.str() +
+                      " violate the triangle inequality I1 + I2 >= I3");
+  Inertia I;
+  I.mass = m;
+  I.com = X.p;
+  // The inertial frame may be rotated with respect to the link frame: the
+  // tensor given in it is R J Rᵀ in the link frame (about the same point).
+  I.inertia_com = X.R * J * X.R.transpose();
+  I.inertia_com = 0.5 * (I.inertia_com + I.inertia_com.transpose());
+  return I;
+}
+
+// <color rgba> must be four numbers in [0, 1]; a top-level <material> must define a
+// colour or a texture (a <material> inside <visual> may only name one).
+void checkMaterial(const XmlSource& src, const TiXmlElement* material, bool top_level) {
+  text(src, material, "name");
+  const TiXmlElement* color = material->FirstChildElement("color");
+  if (color)
+    for (double c : numbers(src, color, "rgba", 4))
+      if (c < 0 || c > 1) fail(src, color, "colour components must lie in [0, 1]");
+  const TiXmlElement* texture = material->FirstChildElement("texture");
+  if (top_level && !color && !(texture && has(texture, "filename")))
+    fail(src, material, "a material needs a <color rgba> or a <texture filename>");
+}
+
+UrdfGeometry readGeometry(const XmlSource& src, const TiXmlElement* holder) {
+  UrdfGeometry out;
+  Geometry& g = out.geometry;
+  g.origin = origin(src, holder);
+  g.name = text(holder, "name", "");
+  const TiXmlElement* ge = holder->FirstChildElement("geometry");
+  if (!ge) fail(src, holder, "missing <geometry>");
+  const TiXmlElement* shape = ge->FirstChildElement();
+  if (!shape) fail(src, ge, "empty <geometry>");
+  if (shape->NextSiblingElement()) fail(src, ge, "more than one shape in <geometry>");
+  out.shape = shape;
+  const std::string type = shape->Value();
+  auto positive = [&](const char* attr) {
+    const double x = number(src, shape, attr);
+    if (x <= 0) fail(src, shape, std::string("'") + attr + "' must be positive");
+    return x;
+  };
+  if (type == "box") {
+    g.type = GeometryType::Box;
+    g.box_size = vec3(src, shape, "size");
+    if (g.box_size.minCoeff() <= 0) fail(src, shape, "box sizes must be positive");
+  } else if (type == "cylinder") {
+    g.type = GeometryType::Cylinder;
+    g.radius = positive("radius");
+    g.length = positive("length");
+  } else if (type == "sphere") {
+    g.type = GeometryType::Sphere;
+    g.radius = positive("radius");
+  } else if (type == "mesh") {
+    g.type = GeometryType::Mesh;
+    g.mesh_uri = text(src, shape, "filename");
+    if (g.mesh_uri.empty()) fail(src, shape, "empty 'filename'");
+    g.mesh_scale = vec3(src, shape, "scale", Vec3::Ones());
+    if (g.mesh_scale.cwiseAbs().minCoeff() == 0) fail(src, shape, "'scale' has a zero component");
+  } else {
+    fail(src, shape, "unsupported geometry <" + type + "> (supported: box, cylinder, sphere, mesh)");
+  }
+  return out;
+}
+
+UrdfLink readLink(const XmlSource& src, const TiXmlElement* l) {
+  UrdfLink link;
+  link.element = l;
+  link.name = text(src, l, "name");
+  if (link.name.empty()) fail(src, l, "empty link name");
+  if (const TiXmlElement* in = l->FirstChildElement("inertial")) {
+    if (in->NextSiblingElement("inertial")) fail(src, l, "more than one <inertial>");
+    link.inertia = readInertial(src, in);
+  }
+  for (const TiXmlElement* v = l->FirstChildElement("visual"); v; v = v->NextSiblingElement("visual")) {
+    link.visual.push_back(readGeometry(src, v));
+    if (const TiXmlElement* m = v->FirstChildElement("material")) checkMaterial(src, m, false);
+  }
+  for (const TiXmlElement* c = l->FirstChildElement("collision"); c;
+       c = c->NextSiblingElement("collision"))
+    link.collision.push_back(readGeometry(src, c));
+  return link;
+}
+
+// The URDF joint types, each with the Model's joint type (URDF has no ball joint).
+struct JointTypeName {
+  const char* name;
+  JointType type;
+};
+constexpr JointTypeName kJointTypes[] = {
+    {"fixed", JointType::Fixed},         {"revolute", JointType::Revolute},
+    {"continuous", JointType::Continuous}, {"prismatic", JointType::Prismatic},
+    {"planar", JointType::Planar},       {"floating", JointType::Floating}};
+
+JointType jointType(const XmlSource& src, const TiXmlElement* j) {
+  const std::string type = text(src, j, "type");
+  std::string known;
+  for (const JointTypeName& t : kJointTypes) {
+    if (type == t.name) return t.type;
+    known += (known.empty() ? "" : ", ") + std::string(t.name);
+  }
+  fail(src, j, "unsupported joint type '" + type + "' (supported: " + known + ")");
+}
+
+bool hasAxis(JointType type) { return type != JointType::Fixed && type != JointType::Floating; }
+
+// <dynamics>, <safety_controller> and <calibration> do not enter the model;
+// their numbers are still checked (URDF requires damping or friction in
+// <dynamics> and k_velocity in <safety_controller>).
+void checkUnusedJointElements(const XmlSource& src, const TiXmlElement* j) {
+  if (const TiXmlElement* d = j->FirstChildElement("dynamics")) {
+    if (!has(d, "damping") && !has(d, "friction"))
+      fail(src, d, "needs 'damping' or 'friction'");
+    number(src, d, "damping", 0.0);
+    number(src, d, "friction", 0.0);
+  }
+  if (const TiXmlElement* s = j->FirstChildElement("safety_controller")) {
+    number(src, s, "k_velocity");
+    for (const char* a : {"soft_lower_limit", "soft_upper_limit", "k_position"}) number(src, s, a, 0.0);
+  }
+  if (const TiXmlElement* c = j->FirstChildElement("calibration"))
+    for (const char* a : {"rising", "falling"}) number(src, c, a, 0.0);
+}
+
+UrdfJoint readJoint(const XmlSource& src, const TiXmlElement* j) {
+  UrdfJoint joint;
+  joint.element = j;
+  joint.name = text(src, j, "name");
+  if (joint.name.empty()) fail(src, j, "empty joint name");
+  joint.type = jointType(src, j);
+  const TiXmlElement* pe = j->FirstChildElement("parent");
+  const TiXmlElement* ce = j->FirstChildElement("child");
+  if (!pe) fail(src, j, "missing <parent>");
+  if (!ce) fail(src, j, "missing <child>");
+  joint.parent = text(src, pe, "link");
+  joint.child = text(src, ce, "link");
+  if (j->FirstChildElement("mimic"))
+    fail(src, j->FirstChildElement("mimic"),
+         "mimic joints are not supported (the coupling is a holonomic constraint this "
+         "loader does not create)");
+  joint.origin = origin(src, j);
+  if (const TiXmlElement* a = j->FirstChildElement("axis")) {
+    const Vec3 axis = vec3(src, a, "xyz");
+    if (hasAxis(joint.type)) {
+      if (axis.norm() < 1e-12) fail(src, a, "joint axis is zero");
+      joint.axis = axis;
+    }
+  }
+  const std::string type = text(src, j, "type");
+  if (const TiXmlElement* lim = j->FirstChildElement("limit")) {
+    // URDF: lower and upper default to 0; effort and velocity are required.
+    const double lo = number(src, lim, "lower", 0.0), hi = number(src, lim, "upper", 0.0);
+    joint.limits.effort = number(src, lim, "effort");
+    joint.limits.velocity = number(src, lim, "velocity");
+    if (joint.type != JointType::Continuous) {
+      if (lo > hi)
+        fail(src, lim, "lower limit " + std::to_string(lo) + " exceeds upper limit " +
+                           std::to_string(hi));
+      joint.limits.lower = lo;
+      joint.limits.upper = hi;
+    }
+  } else if (joint.type == JointType::Revolute || joint.type == JointType::Prismatic) {
+    fail(src, j, "a " + type + " joint needs a <limit> element (URDF requires it)");
+  }
+  checkUnusedJointElements(src, j);
+  return joint;
+}
+
+}  // namespace
+
+UrdfRobot readUrdf(const XmlSource& src, const TiXmlElement* robot) {
+  UrdfRobot ix;
+  if (text(robot, "name", "").empty()) fail(src, robot, "the robot has no name");
+  checkVersion(src, robot);
+
+  std::set<std::string> materials;
+  for (const TiXmlElement* m = robot->FirstChildElement("material"); m;
+       m = m->NextSiblingElement("material")) {
+    checkMaterial(src, m, true);
+    if (!materials.insert(m->Attribute("name")).second)
+      fail(src, m, "material name '" + std::string(m->Attribute("name")) + "' is used twice");
+  }
+
+  for (const TiXmlElement* l = robot->FirstChildElement("link"); l;
+       l = l->NextSiblingElement("link")) {
+    UrdfLink link = readLink(src, l);
+    if (ix.links.count(link.name)) fail(src, l, "link name '" + link.name + "' is used twice");
+    ix.link_order.push_back(link.name);
+    ix.links.emplace(link.name, std::move(link));
+  }
+  if (ix.links.empty()) fail(src, robot, "no <link> elements");
+  ix.has_world = ix.links.count("world") > 0;
+
+  for (const TiXmlElement* j = robot->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint")) {
+    UrdfJoint joint = readJoint(src, j);
+    const std::string& name = joint.name;
+    const std::string& parent = joint.parent;
+    const std::string& child = joint.child;
+    const TiXmlElement* pe = j->FirstChildElement("parent");
+    const TiXmlElement* ce = j->FirstChildElement("child");
+    if (ix.joints.count(name)) fail(src, j, "joint name '" + name + "' is used twice");
+    if (!ix.links.count(parent)) fail(src, pe, "parent link '" + parent + "' is not declared");
+    if (!ix.links.count(child)) fail(src, ce, "child link '" + child + "' is not declared");
+    if (parent == child) fail(src, j, "link '" + child + "' is its own parent");
+    if (child == "world") fail(src, ce, "the world cannot be a child link");
+    if (auto it = ix.parent_joint.find(child); it != ix.parent_joint.end())
+      fail(src, j, "link '" + child + "' has two parents (joints '" + it->second + "' and '" +
+                       name + "')");
+    ix.joint_order.push_back(name);
+    ix.parent_joint[child] = name;
+    ix.child_joints[parent].push_back(name);
+    ix.joints.emplace(name, std::move(joint));
+  }
+
+  // One tree: exactly one link without a parent, and every link reachable.
+  std::vector<std::string> roots;
+  for (const auto& n : ix.link_order)
+    if (!ix.parent_joint.count(n)) roots.push_back(n);
+  if (ix.has_world && ix.parent_joint.count("world") == 0 && roots.size() > 1) {
+    std::string others;
+    for (const auto& r : roots)
+      if (r != "world") others += (others.empty() ? "'" : ", '") + r + "'";
+    fail(src, ix.links.at(roots[roots[0] == "world" ? 1 : 0]).element,
+         "disconnected links: " + others + " not attached to 'world' (a URDF is one tree)");
+  }
+  if (roots.size() > 1)
+    fail(src, ix.links.at(roots[1]).element,
+         "disconnected links: '" + roots[0] + "' and '" + roots[1] +
+             "' both have no parent joint (a URDF is one tree)");
+  if (roots.empty()) fail(src, robot, "no root link: the joints form a cycle");
+  ix.root = roots[0];
+
+  std::set<std::string> seen;
+  std::vector<std::string> stack = {ix.root};
+  while (!stack.empty()) {
+    const std::string l = stack.back();
+    stack.pop_back();
+    seen.insert(l);
+    if (l != "world") ix.body_order.push_back(l);
+    const auto it = ix.child_joints.find(l);
+    if (it == ix.child_joints.end()) continue;
+    // Push in reverse so children come out in document order (depth first).
+    for (auto j = it->second.rbegin(); j != it->second.rend(); ++j) {
+      stack.push_back(ix.joints.at(*j).child);
+    }
+  }
+  for (const auto& n : ix.link_order)
+    if (!seen.count(n))
+      fail(src, ix.links.at(n).element, "link '" + n + "' is not connected to the root '" + ix.root +
+                                    "' (its joints form a cycle)");
+  return ix;
+}
+
+}  // namespace appell::io

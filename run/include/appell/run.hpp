@@ -1,0 +1,110 @@
+// Running a scene: the loop behind `appell run`, for any caller (the command
+// line, a parameter sweep, Python bindings).
+//
+//   runScene(scene, options, observer) → RunSummary
+//
+// builds a Simulator for the scene (its model, constraints, constant joint
+// forces and initial state), steps it to `duration` — fixed steps of dt for
+// euler and rk4 (the last one shortened), the integrator's own suggestion
+// for dopri5 — and reduces the run to a summary while it goes:
+//   energy      E₀ and max_t |E(t) − E₀|, relative to max(|E₀|, T₀) (a
+//               passive scene with time-independent constraints conserves E:
+//               ideal reactions do no work on motions the constraints allow);
+//   residuals   max_t ‖A v + b‖∞ and max_t |g| over the holonomic gaps;
+//   contacts    per constraint, from its rows' kinds (constraint.hpp): the
+//               normal load f_n = λ_normal, the friction demand |f_t| / f_n
+//               with f_t the λ of the tangent and lateral rows, against the
+//               scene's μ, and the samples where the normal pulls (f_n ≤ 0:
+//               a unilateral contact would lift off);
+//   failure     the first step that fails stops the run; the summary keeps
+//               its reason and the time of the last good state.
+// The observer sees the state at t = 0, after every `output_every`-th step
+// and at the end; it may write a trajectory (TrajectoryWriter overload).
+#pragma once
+
+#include <appell/constrained_dynamics.hpp>
+#include <appell/integrators.hpp>
+#include <appell/output.hpp>
+#include <appell/scene.hpp>
+#include <appell/simulator.hpp>
+
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace appell {
+
+struct RunOptions {
+  double duration = 1.0;           ///< simulated time (s)
+  double dt = 1e-3;                ///< fixed step (euler, rk4), first step (dopri5)
+  double tol = 1e-8;               ///< dopri5: relative tolerance (absolute: tol/100)
+  IntegratorType integrator = IntegratorType::RK4;
+  Formulation formulation = Formulation::Tree;
+  bool project_positions = true;   ///< Newton on the holonomic gaps after every step
+  bool project_velocities = true;  ///< impulse solve after every step
+  int output_every = 1;            ///< the observer sees every N-th step (N ≥ 1)
+};
+
+/// The scene's own settings as run options. Throws std::invalid_argument for
+/// an unknown integrator or formulation name, or a non-positive duration,
+/// step or tolerance.
+RunOptions runOptions(const SimulationSettings& settings);
+
+/// One contact's reactions over the run (only for constraints with a normal row).
+struct ContactStats {
+  std::string name;                ///< the constraint's name
+  double mu = std::numeric_limits<double>::infinity();  ///< the scene's μ (∞: unchecked)
+  int normal_row = -1;             ///< λ index of the normal row, −1: none (no stats)
+  std::vector<int> tangential_rows;  ///< λ indices of tangent and lateral rows
+  double min_normal = std::numeric_limits<double>::infinity(), max_normal = 0;
+  double max_demand = 0, t_max_demand = 0;  ///< max |f_t| / f_n and when
+  long pulling = 0, over_mu = 0;   ///< samples with f_n ≤ 0, with |f_t| / f_n > μ
+  double first_pull = -1, first_slip = -1;  ///< when they first happened (−1: never)
+  /// The friction demand exceeded μ or the normal pulled.
+  bool flagged() const { return pulling > 0 || over_mu > 0; }
+};
+
+struct RunSummary {
+  RunOptions options;
+  bool ok = true;                  ///< every step succeeded
+  std::string failure;             ///< why the run stopped (empty when ok)
+  double time = 0;                 ///< time reached (of the last good state when !ok)
+  SimulatorCounters counters;
+  int partition_changes = 0;       ///< re-choices of the Appell velocity partition
+  double wall_seconds = 0;         ///< wall time of the stepping loop
+  bool passive = true;             ///< no joint forces, no moving support: E is conserved
+  double energy0 = 0;              ///< E at t = 0 (J)
+  double max_energy_deviation = 0; ///< max |E − E₀| (J)
+  double energy_scale = 0;         ///< max(|E₀|, T₀, 1e-12)
+  double max_velocity_residual = 0;  ///< max ‖A v + b‖∞, t = 0 included
+  double max_gap_residual = 0;       ///< max |g|, t = 0 included
+  int max_redundant = 0;           ///< most redundant rows at any sample
+  long samples = 0;                ///< states summarised (t = 0 and every step)
+  std::vector<ContactStats> contacts;  ///< one per constraint, in order
+
+  double relativeEnergyDeviation() const { return max_energy_deviation / energy_scale; }
+  int flaggedContacts() const;
+};
+
+/// Sees the simulator's current state (time, q, v, λ, contact frames, energy).
+using RunObserver = std::function<void(const Simulator&)>;
+
+/// A Simulator for the scene: its solver, integrator and projection from the
+/// options, its constant joint forces, its state set to (0, q0, v0). The scene
+/// must outlive it.
+std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& options);
+
+/// Runs the scene (see the top of this file). `on_sample` sees the sampled
+/// states (t = 0, every output_every-th step, the end); `on_step` every
+/// accepted step (e.g. for a progress bar). Throws std::invalid_argument for
+/// bad options; a failing step is not an exception but RunSummary::failure.
+RunSummary runScene(const Scene& scene, const RunOptions& options,
+                    const RunObserver& on_sample = {}, const RunObserver& on_step = {});
+
+/// The same, writing the sampled states to `writer` (made for this scene).
+RunSummary runScene(const Scene& scene, const RunOptions& options, TrajectoryWriter& writer,
+                    const RunObserver& on_step = {});
+
+}  // namespace appell

@@ -1,0 +1,53 @@
+// Contact reactions read the way a vehicle engineer reads them: normal load,
+// friction demand |f_t| / f_n against μ, and normals that pull. λ of a row
+// with direction t is the force along t on the body (constraint.hpp), so the
+// normal row carries the normal load and the tangent and lateral rows the
+// friction force.
+#include "contact_stats.hpp"
+
+#include <cmath>
+
+namespace appell::run_detail {
+
+std::vector<ContactStats> contactStats(const Scene& scene) {
+  std::vector<ContactStats> stats;
+  int offset = 0;
+  for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
+    const Constraint& c = *scene.constraints[k];
+    ContactStats e;
+    e.name = c.name();
+    if (k < scene.contacts.size()) e.mu = scene.contacts[k].mu;
+    for (int r = 0; r < c.rows(); ++r) {
+      const RowKind kind = c.rowKind(r);
+      if (kind == RowKind::Normal) e.normal_row = offset + r;
+      if (isTangential(kind)) e.tangential_rows.push_back(offset + r);
+    }
+    offset += c.rows();
+    stats.push_back(std::move(e));
+  }
+  return stats;
+}
+
+void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda) {
+  for (ContactStats& e : stats) {
+    if (e.normal_row < 0) continue;
+    const double fn = lambda[e.normal_row];
+    double ft2 = 0;
+    for (int r : e.tangential_rows) ft2 += lambda[r] * lambda[r];
+    const double ft = std::sqrt(ft2);
+    e.min_normal = std::min(e.min_normal, fn);
+    e.max_normal = std::max(e.max_normal, fn);
+    if (fn <= 0) {
+      if (e.pulling++ == 0) e.first_pull = t;
+      continue;
+    }
+    const double demand = ft / fn;
+    if (demand > e.max_demand) {
+      e.max_demand = demand;
+      e.t_max_demand = t;
+    }
+    if (demand > e.mu && e.over_mu++ == 0) e.first_slip = t;
+  }
+}
+
+}  // namespace appell::run_detail

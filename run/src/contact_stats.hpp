@@ -1,0 +1,15 @@
+// Accumulating ContactStats (run.hpp) from the multipliers, one sample at a time.
+#pragma once
+
+#include <appell/run.hpp>
+
+namespace appell::run_detail {
+
+/// One entry per constraint; the normal and tangential rows are found by their
+/// kind (RowKind), μ is the scene's (index-aligned contacts).
+std::vector<ContactStats> contactStats(const Scene& scene);
+
+/// Adds the sample (t, λ) to every entry. No allocation.
+void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda);
+
+}  // namespace appell::run_detail

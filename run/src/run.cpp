@@ -1,0 +1,134 @@
+// The run loop and its summary (run.hpp).
+#include "contact_stats.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace appell {
+
+namespace {
+
+void check(const RunOptions& o) {
+  auto positive = [](const char* what, double x) {
+    if (!(x > 0) || !std::isfinite(x))
+      throw std::invalid_argument(std::string("run: ") + what + " must be positive and finite, got " +
+                                  std::to_string(x));
+  };
+  positive("duration", o.duration);
+  positive("dt", o.dt);
+  positive("tol", o.tol);
+  if (o.output_every < 1)
+    throw std::invalid_argument("run: output_every must be at least 1, got " +
+                                std::to_string(o.output_every));
+}
+
+// Energy is conserved when nothing drives the scene: no joint forces and no
+// support that moves (a moving support does work through the reactions).
+bool passiveScene(const Scene& scene) {
+  if (scene.tau.size() && scene.tau.cwiseAbs().maxCoeff() > 0) return false;
+  for (const Support& s : scene.supports)
+    if (isMoving(s.motion)) return false;
+  return true;
+}
+
+}  // namespace
+
+int RunSummary::flaggedContacts() const {
+  return static_cast<int>(
+      std::count_if(contacts.begin(), contacts.end(), [](const ContactStats& c) { return c.flagged(); }));
+}
+
+RunOptions runOptions(const SimulationSettings& settings) {
+  RunOptions o;
+  o.duration = settings.duration;
+  o.dt = settings.dt;
+  o.tol = settings.tol;
+  o.integrator = integratorFromString(settings.integrator);
+  o.formulation = formulationFromString(settings.formulation);
+  check(o);
+  return o;
+}
+
+std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& options) {
+  check(options);
+  IntegratorOptions iopt;
+  iopt.rtol = options.tol;
+  iopt.atol = options.tol * 1e-2;
+  iopt.h_max = std::max(options.dt, options.duration / 20);
+  SimulatorOptions sopt;
+  sopt.project_positions = options.project_positions;
+  sopt.project_velocities = options.project_velocities;
+  auto sim = std::make_unique<Simulator>(
+      scene.model, scene.constraints,
+      makeSolver(options.formulation, scene.model, scene.constraints), options.integrator, iopt,
+      sopt);
+  if (scene.tau.size() == scene.model.nv) {
+    const VecX tau = scene.tau;
+    sim->setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
+  }
+  sim->setState(0.0, scene.q0, scene.v0);  // after the forces: the t = 0 reactions include them
+  return sim;
+}
+
+RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObserver& on_sample,
+                    const RunObserver& on_step) {
+  const std::unique_ptr<Simulator> owned = makeSimulator(scene, options);
+  Simulator& sim = *owned;
+  RunSummary s;
+  s.options = options;
+  s.passive = passiveScene(scene);
+  s.contacts = run_detail::contactStats(scene);
+  s.energy0 = sim.energy();
+  s.energy_scale = std::max({std::abs(s.energy0), sim.kineticEnergy(), 1e-12});
+  s.max_velocity_residual = sim.velocityResidual();
+  s.max_gap_residual = sim.gapResidual();
+  s.max_redundant = sim.redundantRows();
+  run_detail::sample(s.contacts, sim.time(), sim.lambda());
+  s.samples = 1;
+  if (on_sample) on_sample(sim);
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  const bool adaptive = options.integrator == IntegratorType::DormandPrince54;
+  double h = options.dt;
+  long step = 0;
+  while (sim.time() < options.duration * (1 - 1e-12)) {
+    const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
+    if (!status.ok) {
+      s.ok = false;
+      s.failure = status.message;
+      break;
+    }
+    ++step;
+    if (adaptive) h = status.h_next;
+    s.max_energy_deviation = std::max(s.max_energy_deviation, std::abs(sim.energy() - s.energy0));
+    s.max_velocity_residual = std::max(s.max_velocity_residual, sim.velocityResidual());
+    s.max_gap_residual = std::max(s.max_gap_residual, sim.gapResidual());
+    s.max_redundant = std::max(s.max_redundant, sim.redundantRows());
+    run_detail::sample(s.contacts, sim.time(), sim.lambda());
+    ++s.samples;
+    if (on_sample && step % options.output_every == 0) on_sample(sim);
+    if (on_step) on_step(sim);
+  }
+  s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  // The last state reached is always sampled (the failure leaves the last good one).
+  if (on_sample && step % options.output_every != 0) on_sample(sim);
+  s.time = sim.time();
+  s.counters = sim.counters();
+  s.partition_changes = sim.partitionChanges();
+  return s;
+}
+
+RunSummary runScene(const Scene& scene, const RunOptions& options, TrajectoryWriter& writer,
+                    const RunObserver& on_step) {
+  std::vector<ContactFrame> frames(scene.constraints.size());
+  auto write = [&](const Simulator& sim) {
+    for (std::size_t k = 0; k < frames.size(); ++k) frames[k] = sim.contactFrame(static_cast<int>(k));
+    writer.write(sim.time(), sim.q(), sim.v(), sim.energy(),
+                 std::max(sim.velocityResidual(), sim.gapResidual()), frames, sim.lambda());
+  };
+  return runScene(scene, options, write, on_step);
+}
+
+}  // namespace appell

@@ -1,0 +1,190 @@
+// runScene (run.hpp), the loop behind `appell run`: the rolling disk conserves
+// energy and stays on its constraints, its contact loads do not depend on the
+// formulation, the command line prints the same summary, the observer sees
+// the sampled states, and a run that fails says when and why.
+#include <appell/custom_constraint.hpp>
+#include <appell/run.hpp>
+#include <appell/urdf.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <regex>
+#include <sstream>
+
+using namespace appell;
+
+namespace {
+
+const std::string kDisk = std::string(APPELL_SOURCE_DIR) + "/examples/rolling_disk/rolling_disk.urdf";
+
+std::string appellRun(const std::string& args) {
+  const std::string cmd = std::string(APPELL_BINARY_DIR) + "/cli/appell run " + args + " 2>&1";
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  pclose(p);
+  return out;
+}
+
+double field(const std::string& text, const std::string& pattern, int group = 1) {
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex(pattern))) return std::nan("");
+  return std::stod(m[group]);
+}
+
+// |a − b| within `digits` significant digits of printed output.
+void expectPrinted(double printed, double exact, int digits, const std::string& what) {
+  EXPECT_NEAR(printed, exact, std::abs(exact) * std::pow(10.0, 1 - digits)) << what;
+}
+
+}  // namespace
+
+TEST(Run, RollingDiskConservesEnergyAndStaysOnItsConstraints) {
+  const Scene scene = loadScene(kDisk);
+  RunOptions o = runOptions(scene.settings);
+  o.duration = 1.0;
+  double normal_min = 0, normal_max = 0;
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    o.formulation = f;
+    const RunSummary r = runScene(scene, o);
+    ASSERT_TRUE(r.ok) << r.failure;
+    EXPECT_NEAR(r.time, 1.0, 1e-12);
+    EXPECT_TRUE(r.passive);
+    // Rolling without slipping is ideal and time-independent: no work is done.
+    EXPECT_LT(r.relativeEnergyDeviation(), 1e-8) << toString(f);
+    EXPECT_LT(r.max_velocity_residual, 1e-10) << toString(f);
+    EXPECT_LT(r.max_gap_residual, 1e-10) << toString(f);
+    EXPECT_EQ(r.samples, r.counters.steps + 1);
+    // One contact, found by its rows' kinds: normal row 2, tangent rows 0 and 1.
+    ASSERT_EQ(r.contacts.size(), 1u);
+    const ContactStats& c = r.contacts[0];
+    EXPECT_EQ(c.name, "rim");
+    EXPECT_EQ(c.normal_row, 2);
+    EXPECT_EQ(c.tangential_rows, (std::vector<int>{0, 1}));
+    EXPECT_EQ(c.mu, scene.contacts[0].mu);
+    // The disk presses on the floor with about its weight m g (1 kg), and the
+    // formulations agree on λ (unique for independent rows).
+    EXPECT_GT(c.min_normal, 0.9 * 9.81);
+    EXPECT_LT(c.max_normal, 1.1 * 9.81);
+    if (f == Formulation::Tree) {
+      normal_min = c.min_normal;
+      normal_max = c.max_normal;
+    } else {
+      EXPECT_NEAR(c.min_normal, normal_min, 1e-6) << toString(f);
+      EXPECT_NEAR(c.max_normal, normal_max, 1e-6) << toString(f);
+    }
+    EXPECT_FALSE(c.flagged());
+  }
+}
+
+TEST(Run, TheCommandLinePrintsTheSameSummary) {
+  const Scene scene = loadScene(kDisk);
+  RunOptions o = runOptions(scene.settings);
+  o.duration = 1.0;
+  const RunSummary r = runScene(scene, o);
+  const std::string out = appellRun(kDisk + " --duration 1 --quiet");
+  expectPrinted(field(out, R"(simulated\s+([-+0-9.e]+) s)"), r.time, 6, out);
+  EXPECT_EQ(field(out, R"(in ([0-9]+) steps)"), r.counters.steps) << out;
+  EXPECT_EQ(field(out, R"(([0-9]+) dynamics solves)"), r.counters.evaluations) << out;
+  expectPrinted(field(out, R"(E0 = ([-+0-9.e]+) J)"), r.energy0, 6, out);
+  expectPrinted(field(out, R"(max \|E − E0\| = ([-+0-9.e]+) J)"), r.max_energy_deviation, 6, out);
+  expectPrinted(field(out, R"(\(([-+0-9.e]+) relative\))"), r.relativeEnergyDeviation(), 6, out);
+  expectPrinted(field(out, R"(max \|Av\+b\| = ([-+0-9.e]+))"), r.max_velocity_residual, 6, out);
+  expectPrinted(field(out, R"(max \|gap\| = ([-+0-9.e]+))"), r.max_gap_residual, 6, out);
+  expectPrinted(field(out, R"(rim\s+normal load ([-+0-9.e]+))"), r.contacts[0].min_normal, 4, out);
+  expectPrinted(field(out, R"(normal load [-+0-9.e]+ … ([-+0-9.e]+) N)"), r.contacts[0].max_normal, 4, out);
+  expectPrinted(field(out, R"(friction demand max ([-+0-9.e]+))"), r.contacts[0].max_demand, 4, out);
+  EXPECT_NE(out.find("events       none"), std::string::npos) << out;
+}
+
+TEST(Run, TheObserverSeesEveryNthStepAndTheEnd) {
+  const Scene scene = loadScene(kDisk);
+  RunOptions o = runOptions(scene.settings);
+  o.integrator = IntegratorType::RK4;
+  o.dt = 0.01;
+  o.duration = 0.255;  // 26 steps, the last one shortened
+  o.output_every = 5;
+  std::vector<double> times;
+  long steps = 0;
+  const RunSummary r = runScene(
+      scene, o, [&](const Simulator& sim) { times.push_back(sim.time()); },
+      [&](const Simulator&) { ++steps; });
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.counters.steps, 26);
+  EXPECT_EQ(steps, 26);
+  // t = 0, steps 5, 10, …, 25, and the last (26th) step.
+  ASSERT_EQ(times.size(), 7u);
+  EXPECT_EQ(times.front(), 0.0);
+  EXPECT_NEAR(times[1], 0.05, 1e-12);
+  EXPECT_NEAR(times[5], 0.25, 1e-12);
+  EXPECT_NEAR(times.back(), 0.255, 1e-12);
+  // The same samples through a TrajectoryWriter: the header and one line each.
+  std::ostringstream csv;
+  TrajectoryWriter writer(csv, scene);
+  runScene(scene, o, writer);
+  EXPECT_EQ(writer.samples(), 7);
+  EXPECT_NE(csv.str().find("lambda:rim.normal"), std::string::npos);
+}
+
+TEST(Run, AFailingRunReportsItsTimeAndReason) {
+  // A slider with two copies of one velocity row, A = [1; 1], whose
+  // acceleration terms disagree once t > 0.2575: from then on no motion
+  // satisfies both (0 = 1), and the step from t = 0.25 (stages up to 0.26)
+  // fails. The run keeps the last good state, t = 0.25.
+  ModelBuilder b;
+  b.addBody("slider", -1, SE3::Identity(), JointType::Prismatic, Vec3::UnitX(),
+            Inertia{1.0, Vec3::Zero(), 0.1 * Mat3::Identity()});
+  Scene scene;
+  scene.model = b.build();
+  CustomRows rows;
+  rows.name = "twin_rows";
+  rows.rows = 2;
+  rows.A_b = [](const Model&, const VecX&, double, Eigen::Ref<MatX> A, Eigen::Ref<VecX> bb) {
+    A.setOnes();
+    bb.setZero();
+  };
+  rows.bias = [](const Model&, const VecX&, const VecX&, double t, Eigen::Ref<VecX> ab) {
+    ab[0] = 0;
+    ab[1] = t > 0.2575 ? 1.0 : 0.0;
+  };
+  scene.constraints.push_back(std::make_shared<CustomConstraint>(rows));
+  scene.q0 = VecX::Zero(1);
+  scene.v0 = VecX::Zero(1);
+  scene.source = "<twin rows>";
+  RunOptions o;
+  o.integrator = IntegratorType::RK4;
+  o.dt = 0.01;
+  o.duration = 1.0;
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    o.formulation = f;
+    double last_sample = -1;
+    const RunSummary r = runScene(scene, o, [&](const Simulator& sim) { last_sample = sim.time(); });
+    EXPECT_FALSE(r.ok) << toString(f);
+    EXPECT_NEAR(r.time, 0.25, 1e-12) << toString(f);
+    EXPECT_EQ(r.counters.steps, 25) << toString(f);
+    EXPECT_EQ(r.counters.failed, 1) << toString(f);
+    EXPECT_NE(r.failure.find("twin_rows"), std::string::npos) << toString(f) << ": " << r.failure;
+    // The last good state is the last sample (a trajectory ends there).
+    EXPECT_EQ(last_sample, r.time) << toString(f);
+  }
+}
+
+TEST(Run, BadOptionsAreRejected) {
+  SimulationSettings s;
+  s.integrator = "leapfrog";
+  EXPECT_THROW(runOptions(s), std::invalid_argument);
+  s = SimulationSettings{};
+  s.formulation = "quantum";
+  EXPECT_THROW(runOptions(s), std::invalid_argument);
+  const Scene scene = loadScene(kDisk);
+  RunOptions o = runOptions(scene.settings);
+  o.output_every = 0;
+  EXPECT_THROW(runScene(scene, o), std::invalid_argument);
+  o.output_every = 1;
+  o.dt = -1;
+  EXPECT_THROW(runScene(scene, o), std::invalid_argument);
+}
