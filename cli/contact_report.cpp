@@ -11,7 +11,9 @@ ContactReport::ContactReport(const Scene& scene) {
     const Constraint& c = *scene.constraints[k];
     Entry e;
     e.name = c.name();
-    e.mu = k < scene.contacts.size() ? scene.contacts[k].mu : std::numeric_limits<double>::infinity();
+    // μ belongs to the contact; constraints the scene does not declare as contacts have none.
+    const bool declared = k < scene.contacts.size() && scene.contacts[k] == scene.constraints[k];
+    e.mu = declared ? scene.contacts[k]->mu() : std::numeric_limits<double>::infinity();
     for (int r = 0; r < c.rows(); ++r) {
       const std::string label = c.rowLabel(r);
       // λ of a row with direction t is the force along t on the body (constraint.hpp),
