@@ -6,6 +6,7 @@
 
 #include <Eigen/QR>
 
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 
@@ -44,12 +45,14 @@ int info(int argc, char** argv) {
   std::cout << "\n" << scene.contacts.size() << " contacts, " << scene.constraintRows()
             << " constraint rows\n";
   for (size_t k = 0; k < scene.contacts.size(); ++k) {
-    const ContactInfo& c = scene.contacts[k];
-    const Constraint& con = *scene.constraints[k];
-    std::cout << "  " << std::setw(22) << c.name << " link " << std::setw(14) << c.link
-              << " " << std::setw(20) << toString(c.kind) << " on " << std::setw(10) << c.support
-              << " shape " << c.shape_source << ", rows:";
-    for (int r = 0; r < con.rows(); ++r) std::cout << " " << con.rowLabel(r);
+    const ShapeContact& c = *scene.contacts[k];
+    std::cout << "  " << std::setw(22) << c.name() << " link " << std::setw(14)
+              << m.body_names[c.bodyA()] << " " << std::setw(20) << toString(c.kind()) << " on "
+              << std::setw(10) << c.support().name << " shape "
+              << scene.contact_origins[k].shape_source;
+    if (std::isfinite(c.mu())) std::cout << ", μ " << c.mu();
+    std::cout << ", rows:";
+    for (int r = 0; r < c.rows(); ++r) std::cout << " " << c.rowLabel(r);
     std::cout << "\n";
   }
   if (scene.constraintRows() > 0) {

@@ -25,7 +25,7 @@ scene's initial state and prints the eigenvalues.
                       name: <joint> or <joint>.<coord> as 'appell info' and
                       the CSV name the velocities (e.g. root.vx names the
                       floating base's x position coordinate's rate slot)
-  --formulation F     tree | kkt | appell (default: the scene's)
+  --formulation F     {formulations} (default: the scene's)
   --zero-tol TOL      |μ| below which an eigenvalue counts as zero (default 1e-4)
 
 Exit status 3 when the reference is not an equilibrium / steady motion.
@@ -38,7 +38,7 @@ int linearize(int argc, char** argv) {
   Args args(argc, argv, 2, {"cyclic", "formulation", "zero-tol", "package-path"},
             {"help", "equilibrium", "project-initial"});
   if (args.has("help")) {
-    std::cout << kHelp;
+    std::cout << helpText(kHelp);
     return 0;
   }
   const Scene scene = loadFromArgs(args, !args.has("equilibrium"));

@@ -22,8 +22,8 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
   --dt H              fixed step (euler, rk4), first step (dopri5)
   --tol TOL           relative tolerance of the adaptive integrator (dopri5);
                       giving --tol without --integrator selects dopri5
-  --integrator NAME   euler | rk4 | dopri5
-  --formulation F     tree | kkt | appell   (default: the scene's, else tree)
+  --integrator NAME   {integrators}
+  --formulation F     {formulations}   (default: the scene's, else tree)
   --out FILE.csv      write the trajectory (every step, or every --every N)
   --every N           write every N-th step to the CSV (default 1)
   --plot              plot the trajectory at the end (as `appell plot`, into
@@ -129,7 +129,7 @@ int run(int argc, char** argv) {
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path"},
             {"project-initial", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
-    std::cout << kHelp;
+    std::cout << helpText(kHelp);
     return 0;
   }
   Scene scene = loadFromArgs(args);
@@ -137,7 +137,8 @@ int run(int argc, char** argv) {
   s.duration = args.positiveNumber("duration", s.duration);
   s.dt = args.positiveNumber("dt", s.dt);
   s.tol = args.positiveNumber("tol", s.tol);
-  if (args.has("tol") && !args.has("integrator")) s.integrator = "dopri5";
+  if (args.has("tol") && !args.has("integrator"))
+    s.integrator = toString(IntegratorType::DormandPrince54);
   s.integrator = args.text("integrator", s.integrator);
   s.formulation = args.text("formulation", s.formulation);
   if (args.has("plot") && !args.has("out")) throw UsageError("--plot plots the trajectory: give --out FILE.csv");

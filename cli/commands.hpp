@@ -21,6 +21,10 @@ inline const std::set<std::string> kLoadFlags = {"project-initial", "help"};
 /// Loads the scene named by the single positional argument.
 Scene loadFromArgs(const Args& args, bool check_initial = true);
 
+/// A help text with "{integrators}" and "{formulations}" replaced by the
+/// canonical names of integratorTable() and formulationTable() ("a | b | c").
+std::string helpText(const char* text);
+
 /// Velocity-coordinate names, one per entry of v (and of the local coordinates θ):
 /// "<joint>" or "<joint>.<coord>".
 std::vector<std::string> velocityNames(const Model& model);

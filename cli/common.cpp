@@ -1,5 +1,8 @@
 #include "commands.hpp"
 
+#include <appell/constrained_dynamics.hpp>
+#include <appell/integrators.hpp>
+
 #include <sstream>
 
 namespace appell::cli {
@@ -12,6 +15,17 @@ Scene loadFromArgs(const Args& args, bool check_initial) {
   opt.check_initial_state = check_initial;
   opt.project_initial_state = args.has("project-initial");
   return loadScene(args.positional()[0], opt);
+}
+
+std::string helpText(const char* text) {
+  std::string s = text;
+  auto replace = [&](const std::string& key, const std::string& names) {
+    for (auto at = s.find(key); at != std::string::npos; at = s.find(key, at + names.size()))
+      s.replace(at, key.size(), names);
+  };
+  replace("{integrators}", canonicalNames(integratorTable()));
+  replace("{formulations}", canonicalNames(formulationTable()));
+  return s;
 }
 
 std::vector<std::string> velocityNames(const Model& model) {

@@ -177,9 +177,9 @@ std::vector<std::string> writePlots(const std::string& csv, const std::string& d
       demand_plot += sep + "'contacts.dat' using 1:" + std::to_string(3 + 2 * k) +
                      " with lines lw 2 lc " + std::to_string(lc) + " title " + quoted(c.name);
       const int ci = scene ? scene->contactIndex(c.name) : -1;
-      if (ci >= 0 && std::isfinite(scene->contacts[ci].mu)) {
+      if (ci >= 0 && std::isfinite(scene->contacts[ci]->mu())) {
         char mu[32];
-        *std::to_chars(mu, mu + sizeof mu - 1, scene->contacts[ci].mu).ptr = 0;
+        *std::to_chars(mu, mu + sizeof mu - 1, scene->contacts[ci]->mu()).ptr = 0;
         demand_plot += ", " + std::string(mu) + " with lines dt 2 lw 2 lc " + std::to_string(lc) +
                        " title " + quoted("μ " + c.name + " = " + mu);
       }

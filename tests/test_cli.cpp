@@ -1,5 +1,8 @@
 // The `appell` command as a user meets it: exit codes, messages that name the
 // problem, and a run whose summary reports conserved energy.
+#include <appell/constrained_dynamics.hpp>
+#include <appell/integrators.hpp>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -50,6 +53,33 @@ TEST(Cli, HelpAndUsage) {
   EXPECT_NE(bad.output.find("quantum"), std::string::npos) << bad.output;
   EXPECT_EQ(sh("run " + kDisk + " --duration -1").status, 2);
   EXPECT_EQ(sh("run " + kDisk + " --bogus 3").status, 2);
+}
+
+// The help texts and the options read the integrator and formulation tables.
+TEST(Cli, HelpAndOptionsFollowTheNameTables) {
+  const Result run = sh("run --help"), lin = sh("linearize --help");
+  for (const auto& e : appell::integratorTable())
+    EXPECT_NE(run.output.find(e.name), std::string::npos) << e.name << "\n" << run.output;
+  for (const auto& e : appell::formulationTable()) {
+    EXPECT_NE(run.output.find(e.name), std::string::npos) << e.name << "\n" << run.output;
+    EXPECT_NE(lin.output.find(e.name), std::string::npos) << e.name << "\n" << lin.output;
+  }
+  EXPECT_EQ(run.output.find("{integrators}"), std::string::npos) << run.output;
+  // Aliases are accepted on the command line too.
+  const Result r = sh("run " + kDisk + " --duration 0.05 --quiet --formulation multipliers "
+                      "--integrator dormand-prince");
+  EXPECT_EQ(r.status, 0) << r.output;
+  const Result bad = sh("run " + kDisk + " --integrator leapfrog");
+  EXPECT_EQ(bad.status, 2);
+  for (const auto& e : appell::integratorTable())
+    EXPECT_NE(bad.output.find(e.name), std::string::npos) << bad.output;
+}
+
+// μ belongs to the contact: `info` reads it back from the constraint.
+TEST(Cli, InfoShowsTheContactsFrictionCoefficient) {
+  const Result r = sh("info " + std::string(APPELL_SOURCE_DIR) + "/tests/data/io/scenes/ball_turntable.urdf");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("μ 0.6"), std::string::npos) << r.output;
 }
 
 TEST(Cli, BadSceneNamesTheFile) {

@@ -161,8 +161,7 @@ auto centralDiff(F&& f, double h) {
 
 inline bool rollsOn(const Shape& s) { return canRoll(s); }
 inline bool hasBlade(const Shape& s) {
-  return std::holds_alternative<PointShape>(s) || std::holds_alternative<Disk>(s) ||
-         std::holds_alternative<Torus>(s);
+  return shapeType(s).role == ShapeRole::Point || wheelAxis(s) != nullptr;
 }
 
 }  // namespace appell::testing

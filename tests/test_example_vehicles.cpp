@@ -149,14 +149,14 @@ TEST(ExampleDiffDrive, TyresAreToriFromTheCylinderCollisions) {
   const Scene s = loadScene(examplePath("diff_drive/diff_drive.urdf"));
   ASSERT_EQ(s.contacts.size(), 3u);
   for (int k = 0; k < 2; ++k) {
-    const auto* torus = std::get_if<Torus>(&s.contacts[k].shape);
-    ASSERT_NE(torus, nullptr) << s.contacts[k].name << ": " << shapeName(s.contacts[k].shape);
+    const auto* torus = std::get_if<Torus>(&s.contacts[k]->shape());
+    ASSERT_NE(torus, nullptr) << s.contacts[k]->name() << ": " << shapeName(s.contacts[k]->shape());
     EXPECT_NEAR(torus->major + torus->minor, 0.1, 1e-15);  // outer radius = the cylinder's
     EXPECT_NEAR(torus->minor, 0.02, 1e-15);
     EXPECT_NEAR(std::abs(torus->axis.dot(Vec3::UnitY())), 1.0, 1e-12);  // the axle, link frame
   }
-  EXPECT_NE(std::get_if<Sphere>(&s.contacts[2].shape), nullptr);
-  EXPECT_EQ(s.contacts[2].kind, ContactKind::Sliding);
+  EXPECT_NE(std::get_if<Sphere>(&s.contacts[2]->shape()), nullptr);
+  EXPECT_EQ(s.contacts[2]->kind(), ContactKind::Sliding);
 }
 
 TEST(ExampleDiffDrive, EqualTorquesDriveStraightWithTheClosedFormAcceleration) {
@@ -250,8 +250,8 @@ void expectPlanarLoads(const Scene& s, const VecX& lambda, double S, double W, d
   ASSERT_EQ(n.size(), 4u);
   const double a = 0.4;
   for (int k = 0; k < 4; ++k) {
-    const double x = s.contacts[k].name.rfind("front", 0) == 0 ? a : -a;
-    EXPECT_NEAR(lambda[n[k]], W / 4 + x * S / (4 * a * a), tol) << when << ": " << s.contacts[k].name;
+    const double x = s.contacts[k]->name().rfind("front", 0) == 0 ? a : -a;
+    EXPECT_NEAR(lambda[n[k]], W / 4 + x * S / (4 * a * a), tol) << when << ": " << s.contacts[k]->name();
     EXPECT_GT(lambda[n[k]], 0.1 * W / 4) << when;
   }
   EXPECT_NEAR(lambda[n[0]] + lambda[n[1]] + lambda[n[2]] + lambda[n[3]], W, tol) << when;
@@ -276,7 +276,7 @@ TEST(ExampleCar, RedundantRowsAndMinimumNormLoadsInSteadyMotion) {
   advance(*sim, 2.0, st, [&](const Simulator& si) {
     max_energy_dev = std::max(max_energy_dev, std::abs(si.energy() - E0));
     for (int k : normalRows(s)) {
-      const double x = s.contacts[k / 3].name.rfind("front", 0) == 0 ? 0.4 : -0.4;
+      const double x = s.contacts[k / 3]->name().rfind("front", 0) == 0 ? 0.4 : -0.4;
       max_load_err = std::max(max_load_err, std::abs(si.lambda()[k] - (c.W / 4 + x * c.W * c.xc / (4 * 0.16))));
     }
   });

@@ -39,15 +39,19 @@ TEST(IoScene, BallOnTurntable) {
 
   ASSERT_EQ(s.contacts.size(), 1u);
   ASSERT_EQ(s.constraints.size(), 1u);
-  const ContactInfo& c = s.contacts[0];
-  EXPECT_EQ(c.name, "ball_table");
-  EXPECT_EQ(c.link, "ball");
-  EXPECT_EQ(c.body, 0);
-  EXPECT_EQ(c.kind, ContactKind::Rolling);
-  EXPECT_EQ(c.support_index, 0);
-  EXPECT_DOUBLE_EQ(c.mu, 0.6);
-  EXPECT_EQ(c.shape_source, "collision[0] (sphere)");
-  EXPECT_DOUBLE_EQ(as<Sphere>(c.shape).radius, 0.1);
+  // The contact is described once, by its constraint.
+  const ShapeContact& c = *s.contacts[0];
+  EXPECT_EQ(s.contacts[0], s.constraints[0]);
+  EXPECT_EQ(c.name(), "ball_table");
+  EXPECT_EQ(s.model.body_names[c.bodyA()], "ball");
+  EXPECT_EQ(c.bodyA(), 0);
+  EXPECT_EQ(c.kind(), ContactKind::Rolling);
+  EXPECT_EQ(c.support().name, s.supports[0].name);
+  EXPECT_DOUBLE_EQ(c.mu(), 0.6);
+  EXPECT_DOUBLE_EQ(c.spec().mu, 0.6);
+  EXPECT_EQ(s.contact_origins[0].shape_source, "collision[0] (sphere)");
+  EXPECT_GT(s.contact_origins[0].line, 0);
+  EXPECT_DOUBLE_EQ(as<Sphere>(c.shape()).radius, 0.1);
   EXPECT_EQ(s.constraints[0]->name(), "ball_table");
   EXPECT_EQ(s.constraints[0]->rows(), 3);
   EXPECT_EQ(s.constraintRows(), 3);
@@ -76,18 +80,19 @@ TEST(IoScene, BallOnTurntable) {
 TEST(IoScene, SleighKnifeEdgeAndSlidingFeet) {
   const Scene s = loadScene(kData + "scenes/sleigh.urdf");
   ASSERT_EQ(s.contacts.size(), 3u);
-  EXPECT_EQ(s.contacts[0].kind, ContactKind::KnifeEdge);
-  EXPECT_EQ(s.contacts[0].shape_source, "explicit");
-  EXPECT_TRUE(as<PointShape>(s.contacts[0].shape).position.isZero());
-  EXPECT_TRUE(s.contacts[0].blade_direction.isApprox(Vec3(2, 0, 0)));
+  EXPECT_EQ(s.contacts[0]->kind(), ContactKind::KnifeEdge);
+  EXPECT_EQ(s.contact_origins[0].shape_source, "explicit");
+  EXPECT_TRUE(as<PointShape>(s.contacts[0]->shape()).position.isZero());
+  EXPECT_TRUE(s.contacts[0]->spec().options.blade_direction.isApprox(Vec3(2, 0, 0)));
+  EXPECT_TRUE(s.contacts[0]->bladeDirection().isApprox(Vec3(1, 0, 0)));
   EXPECT_EQ(s.constraints[0]->rows(), 2);
   EXPECT_EQ(s.constraints[0]->rowLabel(0), "lateral");
   EXPECT_EQ(s.constraints[0]->rowKind(0), RowKind::Lateral);
-  EXPECT_EQ(s.contacts[1].kind, ContactKind::Sliding);
-  EXPECT_TRUE(as<PointShape>(s.contacts[1].shape).position.isApprox(Vec3(0.6, 0.2, 0)));
+  EXPECT_EQ(s.contacts[1]->kind(), ContactKind::Sliding);
+  EXPECT_TRUE(as<PointShape>(s.contacts[1]->shape()).position.isApprox(Vec3(0.6, 0.2, 0)));
   EXPECT_EQ(s.constraints[1]->rows(), 1);
   EXPECT_EQ(s.constraintRows(), 4);
-  EXPECT_TRUE(std::isinf(s.contacts[1].mu));
+  EXPECT_TRUE(std::isinf(s.contacts[1]->mu()));
   // The tilted initial orientation puts all three points on the slope.
   Scene copy = s;
   EXPECT_LT(checkInitialState(copy, false).gap_residual, 1e-14);
@@ -123,38 +128,38 @@ TEST(IoScene, ShapesFromCollisionGeometryAndExplicit) {
   EXPECT_TRUE(std::get<ConstantTwistMotion>(s.supports[3].motion).twist.head<3>().isApprox(Vec3::UnitZ()));
 
   // A cylinder collision is a disk rim in its mid-plane, axle along its z.
-  const Disk& rim = as<Disk>(s.contacts[0].shape);
-  EXPECT_EQ(s.contacts[0].shape_source, "collision[0] (cylinder 'tread')");
+  const Disk& rim = as<Disk>(s.contacts[0]->shape());
+  EXPECT_EQ(s.contact_origins[0].shape_source, "collision[0] (cylinder 'tread')");
   EXPECT_DOUBLE_EQ(rim.radius, 0.3);
   EXPECT_TRUE(rim.centre.isApprox(Vec3(0, 0.01, 0)));
   EXPECT_TRUE(rim.axis.isApprox(Vec3(0, -1, 0), 1e-15));
-  EXPECT_EQ(s.contacts[0].kind, ContactKind::RollingWithoutSpin);
+  EXPECT_EQ(s.contacts[0]->kind(), ContactKind::RollingWithoutSpin);
   EXPECT_EQ(s.constraints[0]->rows(), 4);
   // … or a torus with the same outer radius when a tyre radius is given.
-  const Torus& tyre = as<Torus>(s.contacts[1].shape);
+  const Torus& tyre = as<Torus>(s.contacts[1]->shape());
   EXPECT_DOUBLE_EQ(tyre.minor, 0.04);
   EXPECT_NEAR(tyre.major + tyre.minor, 0.3, 1e-15);
   // Selected by index.
-  EXPECT_DOUBLE_EQ(as<Sphere>(s.contacts[2].shape).radius, 0.05);
-  EXPECT_EQ(s.contacts[2].support, "bowl");
+  EXPECT_DOUBLE_EQ(as<Sphere>(s.contacts[2]->shape()).radius, 0.05);
+  EXPECT_EQ(s.contacts[2]->support().name, "bowl");
   // Explicit ellipsoid with orientation.
-  const Ellipsoid& egg = as<Ellipsoid>(s.contacts[3].shape);
+  const Ellipsoid& egg = as<Ellipsoid>(s.contacts[3]->shape());
   EXPECT_TRUE(egg.semi_axes.isApprox(Vec3(0.1, 0.2, 0.3)));
   EXPECT_TRUE(egg.centre.isApprox(Vec3(0, 0, 0.01)));
   EXPECT_TRUE((egg.orientation * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-15));
-  EXPECT_EQ(s.contacts[3].body, 1);
+  EXPECT_EQ(s.contacts[3]->bodyA(), 1);
   // Hemisphere: cap on the −z side by default.
-  const SphericalCap& cap = as<SphericalCap>(s.contacts[4].shape);
+  const SphericalCap& cap = as<SphericalCap>(s.contacts[4]->shape());
   EXPECT_DOUBLE_EQ(cap.radius, 0.2);
   EXPECT_NEAR(cap.half_angle, M_PI / 2, 1e-15);
   EXPECT_TRUE(cap.axis.isApprox(-Vec3::UnitZ()));
   // Explicit torus: radius is the outer radius.
-  const Torus& t = as<Torus>(s.contacts[5].shape);
+  const Torus& t = as<Torus>(s.contacts[5]->shape());
   EXPECT_NEAR(t.major, 0.2, 1e-15);
   EXPECT_DOUBLE_EQ(t.minor, 0.1);
   EXPECT_TRUE(t.axis.isApprox(Vec3::UnitY()));
   // A knife edge on a disk takes its blade from the wheel plane.
-  EXPECT_EQ(s.contacts[6].kind, ContactKind::KnifeEdge);
+  EXPECT_EQ(s.contacts[6]->kind(), ContactKind::KnifeEdge);
   EXPECT_EQ(s.constraints[6]->rows(), 2);
 }
 

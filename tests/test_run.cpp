@@ -65,7 +65,7 @@ TEST(Run, RollingDiskConservesEnergyAndStaysOnItsConstraints) {
     EXPECT_EQ(c.name, "rim");
     EXPECT_EQ(c.normal_row, 2);
     EXPECT_EQ(c.tangential_rows, (std::vector<int>{0, 1}));
-    EXPECT_EQ(c.mu, scene.contacts[0].mu);
+    EXPECT_EQ(c.mu, scene.contacts[0]->mu());
     // The disk presses on the floor with about its weight m g (1 kg), and the
     // formulations agree on λ (unique for independent rows).
     EXPECT_GT(c.min_normal, 0.9 * 9.81);

@@ -87,7 +87,7 @@ sc::BuiltScene cylinderScene(const sc::BuiltScene& thin, double h) {
   st.velocity += st.omega.cross(h * a);
   setState(st, s.q0, s.v0);
   sc::closeGaps(s.model, s.constraints, s.q0);
-  sc::projectVelocityEuclidean(s.model, s.constraints, s.q0, s.v0);
+  sc::projectVelocity(s.model, s.constraints, s.q0, s.v0);
   return s;
 }
 

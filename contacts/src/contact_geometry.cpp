@@ -53,7 +53,7 @@ void contactGeometry(const Shape& shape, const SupportSurface& surface,
     detail::markSingular(out, "collision-only shape has no smooth contact point");
     return;
   }
-  std::visit(detail::Overloaded{
+  std::visit(Overloaded{
                  [&](const Plane& p) {
                    detail::planeGeometry(shape, p, support, body_pose, body_velocity, out, options);
                  },

@@ -2,15 +2,9 @@
 #pragma once
 
 #include <appell/contact_geometry.hpp>
+#include <appell/overloaded.hpp>
 
 namespace appell::detail {
-
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
 
 /// World spatial velocity split into its parts.
 struct Twist {
@@ -39,6 +33,14 @@ void planeGeometry(const Shape& shape, const Plane& plane, const SupportState& S
 void sphereSurfaceGeometry(const Shape& shape, const SphereSurface& sphere, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
                            const GeometryOptions& opt);
+
+/// Body-frame outward normal m of the shape's point nearest to (outside = true)
+/// or farthest from (outside = false) the body-frame point s: in closed form,
+/// or by Newton for the ellipsoid (`iterations` then counts its steps). Returns
+/// false with a static reason where it is not unique or does not exist (m is
+/// then a finite stand-in). Defined with the shapes (shapes.cpp).
+bool extremalNormal(const Shape& shape, const Vec3& s, bool outside, const GeometryOptions& opt,
+                    Vec3& m, int& iterations, const char*& reason);
 
 /// Body-frame outward normal m of the ellipsoid point nearest to (outside = true)
 /// or farthest from (outside = false) the body-frame point s, by Newton's method

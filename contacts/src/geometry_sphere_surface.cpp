@@ -16,75 +16,6 @@
 
 namespace appell::detail {
 
-namespace {
-
-// Normal for shapes whose extreme point is closed-form. Returns false with a reason.
-bool closedFormNormal(const Shape& shape, const Vec3& s, bool outside, double tol, Vec3& m,
-                      const char*& reason) {
-  auto fromCentre = [&](const Vec3& c, double size) {
-    const Vec3 dir = outside ? Vec3(s - c) : Vec3(c - s);
-    const double len = dir.norm();
-    if (len <= tol * (size + s.norm())) {
-      reason = "the support sphere's centre coincides with the shape's centre: every direction "
-               "is a contact normal";
-      m = Vec3::UnitZ();
-      return false;
-    }
-    m = dir / len;
-    return true;
-  };
-  return std::visit(
-      Overloaded{
-          [&](const PointShape& x) { return fromCentre(x.position, 1.0); },
-          [&](const Sphere& x) { return fromCentre(x.centre, x.radius); },
-          [&](const SphericalCap& x) { return fromCentre(x.centre, x.radius); },
-          [&](const auto& wheel) -> bool {
-            // Disk or torus: the tube centre nearest C (outside) or farthest from it
-            // (inside) lies on the centre circle, in the direction of C's projection.
-            Vec3 c, a;
-            double Rm;
-            if constexpr (std::is_same_v<std::decay_t<decltype(wheel)>, Disk>) {
-              c = wheel.centre;
-              a = wheel.axis;
-              Rm = wheel.radius;
-            } else if constexpr (std::is_same_v<std::decay_t<decltype(wheel)>, Torus>) {
-              c = wheel.centre;
-              a = wheel.axis;
-              Rm = wheel.major;
-            } else {
-              reason = "shape has no closed-form contact";
-              return false;
-            }
-            const Vec3 w = (s - c) - a * a.dot(s - c);
-            const double wl = w.norm();
-            m = -a;
-            if (wl <= tol * (Rm + s.norm())) {
-              reason = "the support sphere's centre lies on the wheel's axis: every rim point is "
-                       "equally near, no unique contact";
-              return false;
-            }
-            const Vec3 u = outside ? Vec3(w / wl) : Vec3(-w / wl);
-            const Vec3 k = c + Rm * u;  // tube centre at the contact
-            const Vec3 dir = outside ? Vec3(s - k) : Vec3(k - s);
-            const double len = dir.norm();
-            if (len <= tol * (Rm + s.norm())) {
-              reason = "the support sphere's centre lies on the wheel's rim circle";
-              return false;
-            }
-            m = dir / len;
-            // The Gauss map covers the outer (convex) part of the wheel only.
-            if ((m - a * a.dot(m)).dot(u) <= 0) {
-              reason = "contact on the inner (non-convex) side of the wheel: the sphere pokes "
-                       "through the wheel's hole";
-              return false;
-            }
-            return true;
-          }},
-      shape);
-}
-
-}  // namespace
-
 void sphereSurfaceGeometry(const Shape& shape, const SphereSurface& sphere, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
                            const GeometryOptions& opt) {
@@ -97,16 +28,7 @@ void sphereSurfaceGeometry(const Shape& shape, const SphereSurface& sphere, cons
 
   Vec3 m;
   const char* reason = nullptr;
-  bool ok;
-  if (const auto* el = std::get_if<Ellipsoid>(&shape)) {
-    ok = ellipsoidExtremalNormal(*el, s, outside, opt, m, out.iterations, reason);
-    if (!ok) {  // a finite stand-in for the report
-      const Vec3 dir = outside ? Vec3(s - el->centre) : Vec3(el->centre - s);
-      m = dir.norm() > 0 && dir.allFinite() ? Vec3(dir.normalized()) : Vec3(Vec3::UnitZ());
-    }
-  } else {
-    ok = closedFormNormal(shape, s, outside, opt.singular_tol, m, reason);
-  }
+  const bool ok = extremalNormal(shape, s, outside, opt, m, out.iterations, reason);
   const GaussPoint g = inverseGaussMap(shape, m, opt.singular_tol);
   const double d = eps * m.dot(g.y - s);
 

@@ -5,6 +5,8 @@
 #include "contact_kinds.hpp"
 #include "geometry_internal.hpp"
 
+#include <appell/name_table.hpp>
+
 #include <sstream>
 #include <stdexcept>
 
@@ -22,107 +24,104 @@ int rowCount(ContactKind kind) {
   return 0;
 }
 
-bool isWheel(const Shape& s) {
-  return std::holds_alternative<Disk>(s) || std::holds_alternative<Torus>(s);
-}
-
 }  // namespace
 
-const char* toString(ContactKind kind) {
-  switch (kind) {
-    case ContactKind::Rolling: return "rolling";
-    case ContactKind::RollingWithoutSpin: return "rolling_without_spin";
-    case ContactKind::KnifeEdge: return "knife_edge";
-    case ContactKind::Sliding: return "sliding";
-  }
-  return "?";
+std::span<const NamedValue<ContactKind>> contactKindTable() {
+  static const NamedValue<ContactKind> table[] = {
+      {ContactKind::Rolling, "rolling", {}, "no slip: rows tangent1, tangent2, normal"},
+      {ContactKind::RollingWithoutSpin, "rolling_without_spin", {"rolling_no_spin", "rubber"},
+       "no slip and no spin about the normal: rows tangent1, tangent2, normal, spin"},
+      {ContactKind::KnifeEdge, "knife_edge", {"knife"},
+       "no sideways slip of a blade (a point with a direction, or a wheel plane): rows lateral, "
+       "normal"},
+      {ContactKind::Sliding, "sliding", {}, "frictionless, stays on the support: row normal"},
+  };
+  return table;
 }
 
+const char* toString(ContactKind kind) { return entryOf(contactKindTable(), kind).name; }
+
 ContactKind contactKindFromString(const std::string& text) {
-  if (text == "rolling") return ContactKind::Rolling;
-  if (text == "rolling_without_spin" || text == "rolling-without-spin" || text == "rolling_no_spin" ||
-      text == "rubber")
-    return ContactKind::RollingWithoutSpin;
-  if (text == "knife_edge" || text == "knife-edge" || text == "knife") return ContactKind::KnifeEdge;
-  if (text == "sliding") return ContactKind::Sliding;
-  throw std::invalid_argument("unknown contact kind '" + text +
-                              "' (expected rolling, rolling_without_spin, knife_edge or sliding)");
+  return parseName(contactKindTable(), text, "contact kind");
 }
 
 ShapeContact::ShapeContact(ContactKind kind, int body, Shape shape, Support support,
                            const ContactOptions& options)
-    : kind_(kind),
-      body_(body),
-      shape_(std::move(shape)),
-      support_(std::move(support)),
-      geometry_options_(options.geometry),
-      rows_(rowCount(kind)) {
-  if (options.name.empty()) {
+    : ShapeContact(ContactSpec{kind, body, std::move(shape), std::move(support),
+                               std::numeric_limits<double>::infinity(), options}) {}
+
+ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(rowCount(spec_.kind)) {
+  const ContactKind kind = spec_.kind;
+  const int body = spec_.body;
+  const Shape& shape = spec_.shape;
+  Support& support = spec_.support;
+  std::string& name = spec_.options.name;
+  if (name.empty()) {
     std::ostringstream s;
-    s << toString(kind) << "(body " << body << ", " << shapeName(shape_) << " on "
-      << support_.name << ")";
-    name_ = s.str();
-  } else {
-    name_ = options.name;
+    s << toString(kind) << "(body " << body << ", " << shapeName(shape) << " on " << support.name
+      << ")";
+    name = s.str();
   }
   auto fail = [&](const std::string& why) {
-    throw std::invalid_argument("contact '" + name_ + "': " + why);
+    throw std::invalid_argument("contact '" + name + "': " + why);
   };
   if (body < 0) fail("body index must be ≥ 0 (the world cannot carry a contact shape)");
-  if (support_.body == body) fail("the support cannot be carried by the contact's own body");
-  if (support_.body < -1) fail("support body index must be ≥ −1");
-  if (support_.body >= 0 && !std::holds_alternative<StaticMotion>(support_.motion))
+  if (support.body == body) fail("the support cannot be carried by the contact's own body");
+  if (support.body < -1) fail("support body index must be ≥ −1");
+  if (support.body >= 0 && !std::holds_alternative<StaticMotion>(support.motion))
     fail("a support carried by a body moves with it: give a StaticMotion (its pose on the body)");
+  if (!(spec_.mu >= 0))
+    fail("the friction coefficient μ must be ≥ 0 (∞: no limit)");
   try {
-    validateShape(shape_);
-    validateSupport(support_);
+    validateShape(shape);
+    validateSupport(support);
   } catch (const std::invalid_argument& e) {
     fail(e.what());
   }
-  if (auto* p = std::get_if<Plane>(&support_.surface)) p->normal.normalize();
+  if (auto* p = std::get_if<Plane>(&support.surface)) p->normal.normalize();
   // Face normals, adjacency and the box tree, once (evaluation must not allocate).
-  if (auto* t = std::get_if<TerrainMesh>(&support_.surface); t && !t->index)
+  if (auto* t = std::get_if<TerrainMesh>(&support.surface); t && !t->index)
     *t = makeTerrain(t->vertices, t->triangles);
   std::string why;
   switch (kind) {
     case ContactKind::Rolling:
     case ContactKind::RollingWithoutSpin:
-      if (!canRoll(shape_, &why)) fail(why);
+      if (!canRoll(shape, &why)) fail(why);
       break;
-    case ContactKind::KnifeEdge:
-      if (std::holds_alternative<PointShape>(shape_)) {
-        const Vec3& b = options.blade_direction;
+    case ContactKind::KnifeEdge: {
+      const Vec3& b = spec_.options.blade_direction;
+      if (shapeType(shape).role == ShapeRole::Point) {
         if (!b.allFinite() || b.norm() < 1e-12)
           fail("knife edge on a point needs a non-zero blade direction");
         blade_ = b.normalized();
-      } else if (isWheel(shape_)) {
-        if (options.blade_direction.norm() != 0)
+      } else if (const Vec3* axle = wheelAxis(shape)) {
+        if (b.norm() != 0)
           fail("a disk or torus knife edge uses its wheel plane as the blade; leave "
                "blade_direction unset");
-        blade_ = std::holds_alternative<Disk>(shape_) ? std::get<Disk>(shape_).axis
-                                                      : std::get<Torus>(shape_).axis;
+        blade_ = *axle;
       } else {
         fail(std::string("a knife edge needs a blade: a point with a blade direction, or a disk "
                          "or torus wheel (got a ") +
-             shapeName(shape_) + ")");
+             shapeName(shape) + ")");
       }
       break;
+    }
     case ContactKind::Sliding:
-      if (!isSmoothContactShape(shape_))
-        fail(std::string("a ") + shapeName(shape_) +
+      if (!isSmoothContactShape(shape))
+        fail(std::string("a ") + shapeName(shape) +
              " has no smooth contact point; sliding needs a point or a smooth convex shape");
       break;
   }
-  if (const auto* sp = std::get_if<SphereSurface>(&support_.surface)) {
-    if (sp->side == SphereSurface::Side::Inside && !fitsInBowl(shape_, sp->radius, &why))
-      fail("does not fit the bowl '" + support_.name + "': " + why);
+  if (const auto* sp = std::get_if<SphereSurface>(&support.surface)) {
+    if (sp->side == SphereSurface::Side::Inside && !fitsInBowl(shape, sp->radius, &why))
+      fail("does not fit the bowl '" + support.name + "': " + why);
   }
 }
 
 RowKind ShapeContact::rowKind(int k) const {
   static constexpr RowKind rolling[] = {RowKind::Tangent1, RowKind::Tangent2, RowKind::Normal,
                                         RowKind::Spin};
-  switch (kind_) {
+  switch (spec_.kind) {
     case ContactKind::Rolling:
     case ContactKind::RollingWithoutSpin: return rolling[k];
     case ContactKind::KnifeEdge: return k == 0 ? RowKind::Lateral : RowKind::Normal;
@@ -135,12 +134,12 @@ RowKind ShapeContact::rowKind(int k) const {
 bool ShapeContact::holonomic(int k) const { return rowKind(k) == RowKind::Normal; }
 
 void ShapeContact::reserve(const Model& model, RowBlock& block) const {
-  if (support_.body >= model.nbodies)
-    throw std::invalid_argument("contact '" + name_ + "': support body index " +
-                                std::to_string(support_.body) + " is out of range (the model has " +
+  if (spec_.support.body >= model.nbodies)
+    throw std::invalid_argument("contact '" + name() + "': support body index " +
+                                std::to_string(spec_.support.body) + " is out of range (the model has " +
                                 std::to_string(model.nbodies) + " bodies)");
-  if (body_ >= model.nbodies)
-    throw std::invalid_argument("contact '" + name_ + "': body index " + std::to_string(body_) +
+  if (spec_.body >= model.nbodies)
+    throw std::invalid_argument("contact '" + name() + "': body index " + std::to_string(spec_.body) +
                                 " is out of range (the model has " +
                                 std::to_string(model.nbodies) + " bodies)");
   Constraint::reserve(model, block);
@@ -157,23 +156,23 @@ void ShapeContact::reserve(const Model& model, RowBlock& block) const {
 
 SupportState ShapeContact::supportStateAt(double t, const SE3& support_body_pose,
                                           const Vec6& support_body_velocity) const {
-  if (support_.body < 0) return supportState(support_.motion, t);
+  if (spec_.support.body < 0) return supportState(spec_.support.motion, t);
   SupportState S;
-  S.pose = support_body_pose * std::get<StaticMotion>(support_.motion).pose;
+  S.pose = support_body_pose * std::get<StaticMotion>(spec_.support.motion).pose;
   S.V = support_body_velocity;
   return S;  // A = 0: the carrying body's acceleration enters through Wb
 }
 
 void ShapeContact::geometry(const SE3& body_pose, const Vec6& body_velocity, double t,
                             ContactGeometry& out) const {
-  contactGeometry(shape_, support_.surface, supportStateAt(t), body_pose, body_velocity, out,
-                  geometry_options_);
+  contactGeometry(spec_.shape, spec_.support.surface, supportStateAt(t), body_pose, body_velocity, out,
+                  spec_.options.geometry);
 }
 
 void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
                              const SupportState& S, RowBlock& out) const {
   ContactGeometry g;
-  contactGeometry(shape_, support_.surface, S, body_pose, body_velocity, g, geometry_options_);
+  contactGeometry(spec_.shape, spec_.support.surface, S, body_pose, body_velocity, g, spec_.options.geometry);
   out.m = rows_;
   out.Wa.resize(rows_, 6);
   out.Wb.resize(rows_, 6);
@@ -181,15 +180,15 @@ void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
   out.kappa.resize(rows_);
   out.gap.resize(rows_);
   const char* reason = g.singular ? g.reason : nullptr;
-  switch (kind_) {
+  switch (spec_.kind) {
     case ContactKind::Rolling:
     case ContactKind::RollingWithoutSpin:
-      detail::writeRollingRows(g, body_velocity, S, kind_ == ContactKind::RollingWithoutSpin, out);
+      detail::writeRollingRows(g, body_velocity, S, spec_.kind == ContactKind::RollingWithoutSpin, out);
       break;
     case ContactKind::KnifeEdge: {
       const char* r =
-          detail::writeKnifeEdgeRows(g, body_pose, body_velocity, S, blade_, isWheel(shape_),
-                                     geometry_options_.singular_tol, out);
+          detail::writeKnifeEdgeRows(g, body_pose, body_velocity, S, blade_, wheelAxis(spec_.shape) != nullptr,
+                                     spec_.options.geometry.singular_tol, out);
       if (!reason) reason = r;
       break;
     }
@@ -209,10 +208,10 @@ void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
 
 void ShapeContact::evaluateAt(const SE3& body_pose, const Vec6& body_velocity, double t,
                               RowBlock& out) const {
-  if (support_.body >= 0)
-    throw std::logic_error("contact '" + name_ +
+  if (spec_.support.body >= 0)
+    throw std::logic_error("contact '" + name() +
                            "': the support is carried by a body; use evaluateOnBody");
-  writeRows(body_pose, body_velocity, supportState(support_.motion, t), out);
+  writeRows(body_pose, body_velocity, supportState(spec_.support.motion, t), out);
 }
 
 void ShapeContact::evaluateOnBody(const SE3& body_pose, const Vec6& body_velocity,
@@ -228,14 +227,18 @@ void ShapeContact::evaluateOnBody(const SE3& body_pose, const Vec6& body_velocit
 
 void ShapeContact::evaluate(const Model&, const Data& data, double t, const VecX&, const VecX&,
                             RowBlock& out) const {
-  const SE3& pose = data.oMi[body_];
-  const Vec6 V = pose.act(data.v[body_]);
-  if (support_.body < 0) {
-    writeRows(pose, V, supportState(support_.motion, t), out);
+  const SE3& pose = data.oMi[spec_.body];
+  const Vec6 V = pose.act(data.v[spec_.body]);
+  if (spec_.support.body < 0) {
+    writeRows(pose, V, supportState(spec_.support.motion, t), out);
   } else {
-    const SE3& pb = data.oMi[support_.body];
-    evaluateOnBody(pose, V, pb, pb.act(data.v[support_.body]), out);
+    const SE3& pb = data.oMi[spec_.support.body];
+    evaluateOnBody(pose, V, pb, pb.act(data.v[spec_.support.body]), out);
   }
+}
+
+std::shared_ptr<ShapeContact> makeContact(const ContactSpec& spec) {
+  return std::make_shared<ShapeContact>(spec);
 }
 
 std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,

@@ -1,5 +1,6 @@
 // Prescribed support motions: pose, spatial velocity and acceleration at t.
 #include <appell/supports.hpp>
+#include <appell/overloaded.hpp>
 
 #include <cmath>
 #include <stdexcept>
@@ -7,13 +8,6 @@
 namespace appell {
 
 namespace {
-
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
 
 [[noreturn]] void fail(const Support& s, const std::string& what) {
   throw std::invalid_argument("support '" + s.name + "': " + what);

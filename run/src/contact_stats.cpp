@@ -16,7 +16,9 @@ std::vector<ContactStats> contactStats(const Scene& scene) {
     const Constraint& c = *scene.constraints[k];
     ContactStats e;
     e.name = c.name();
-    if (k < scene.contacts.size()) e.mu = scene.contacts[k].mu;
+    // μ belongs to the contact; constraints the scene does not declare as contacts have none.
+    if (k < scene.contacts.size() && scene.contacts[k] == scene.constraints[k])
+      e.mu = scene.contacts[k]->mu();
     for (int r = 0; r < c.rows(); ++r) {
       const RowKind kind = c.rowKind(r);
       if (kind == RowKind::Normal) e.normal_row = offset + r;

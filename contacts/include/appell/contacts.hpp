@@ -23,37 +23,62 @@
 #include <appell/constraint.hpp>
 #include <appell/contact_geometry.hpp>
 
+#include <appell/name_table.hpp>
+
+#include <limits>
 #include <memory>
 
 namespace appell {
 
 enum class ContactKind { Rolling, RollingWithoutSpin, KnifeEdge, Sliding };
 
-const char* toString(ContactKind kind);
-/// Parses "rolling", "rolling_without_spin" (or "rolling_no_spin", "rubber"), "knife_edge",
-/// "sliding"; throws std::invalid_argument naming the text otherwise.
+/// Every contact kind with its names ("rolling", "rolling_without_spin" /
+/// "rolling_no_spin" / "rubber", "knife_edge" / "knife", "sliding"): the one
+/// list that parsing, error messages and the scene format read.
+std::span<const NamedValue<ContactKind>> contactKindTable();
+const char* toString(ContactKind kind);  ///< the canonical name
+/// Parses any name or alias of contactKindTable() ('-' = '_'); throws
+/// std::invalid_argument listing them all otherwise.
 ContactKind contactKindFromString(const std::string& text);
 
+/// The optional part of a contact's description.
 struct ContactOptions {
-  std::string name;                 ///< empty: "<kind>:<body>:<support>"
+  std::string name;                 ///< empty: "<kind>(body …, <shape> on <support>)"
   /// Knife edges on a PointShape: the blade direction, body frame (any length
   /// > 0). Disks and tori use their wheel plane instead (must stay zero).
   Vec3 blade_direction = Vec3::Zero();
   GeometryOptions geometry;
 };
 
+/// A contact, described once: the constraint keeps this description and
+/// everything downstream (the scene loader, the CLI's reports, the CSV) reads
+/// it back from the constraint.
+struct ContactSpec {
+  ContactKind kind = ContactKind::Rolling;
+  int body = -1;                    ///< the body carrying the shape
+  Shape shape;                      ///< in that body's frame
+  Support support;
+  /// Coulomb friction coefficient (∞: no limit). The rows do not read it yet;
+  /// the friction check of `appell run` does.
+  double mu = std::numeric_limits<double>::infinity();
+  ContactOptions options;
+};
+
 /// One body's smooth shape against a world support. The kinds differ only in
 /// which rows they write.
 class ShapeContact : public Constraint {
  public:
+  /// Checks the description (see makeContact) and keeps it, with its name
+  /// filled in when it was empty.
+  explicit ShapeContact(ContactSpec spec);
   ShapeContact(ContactKind kind, int body, Shape shape, Support support,
                const ContactOptions& options);
 
-  const std::string& name() const override { return name_; }
+  const std::string& name() const override { return spec_.options.name; }
   int rows() const override { return rows_; }
-  int bodyA() const override { return body_; }
+  int bodyA() const override { return spec_.body; }
   /// The body carrying the support, or −1 (world).
-  int bodyB() const override { return support_.body; }
+  int bodyB() const override { return spec_.support.body; }
   RowKind rowKind(int k) const override;
   bool holonomic(int k) const override;
   void reserve(const Model& model, RowBlock& block) const override;
@@ -79,24 +104,24 @@ class ShapeContact : public Constraint {
   SupportState supportStateAt(double t, const SE3& support_body_pose = {},
                               const Vec6& support_body_velocity = Vec6::Zero()) const;
 
-  ContactKind kind() const { return kind_; }
-  const Shape& shape() const { return shape_; }
-  const Support& support() const { return support_; }
-  /// Knife edge: the unit blade direction (body frame); zero otherwise.
+  /// The contact's description, as given (name filled in).
+  const ContactSpec& spec() const { return spec_; }
+  ContactKind kind() const { return spec_.kind; }
+  const Shape& shape() const { return spec_.shape; }
+  const Support& support() const { return spec_.support; }
+  /// Coulomb friction coefficient (∞: no limit).
+  double mu() const { return spec_.mu; }
+  /// Knife edge: the unit blade direction (body frame; a wheel's axle for a
+  /// disk or torus); zero otherwise.
   const Vec3& bladeDirection() const { return blade_; }
 
  private:
   void writeRows(const SE3& body_pose, const Vec6& body_velocity, const SupportState& S,
                  RowBlock& out) const;
 
-  ContactKind kind_;
-  int body_;
-  Shape shape_;
-  Support support_;
+  ContactSpec spec_;
   Vec3 blade_ = Vec3::Zero();
-  GeometryOptions geometry_options_;
   int rows_ = 0;
-  std::string name_;
 };
 
 /// Builds a contact from a declarative description. Throws std::invalid_argument
@@ -104,7 +129,9 @@ class ShapeContact : public Constraint {
 /// cylinder, mesh, point) for rolling kinds, a knife edge without a blade (zero
 /// direction on a point; a sphere or ellipsoid has no blade), a shape that does
 /// not fit its bowl, a negative body index, bad shape or support parameters, a
-/// support carried by the contact's own body or given a prescribed motion.
+/// support carried by the contact's own body or given a prescribed motion, a
+/// negative or NaN μ.
+std::shared_ptr<ShapeContact> makeContact(const ContactSpec& spec);
 std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,
                                           const Support& support,
                                           const ContactOptions& options = {});

@@ -16,12 +16,20 @@
 //   Disk          a torus with tube radius 0: its rim.
 // Box, Cylinder and Mesh are collision-only: they have edges or facets, no
 // unique smooth contact point, so they cannot carry a rolling contact.
+//
+// Every alternative of `Shape` has one entry in shapeTable() (its names, role
+// and scene-file parameters) and one handler in each visit of shapes.cpp —
+// the visits have no catch-all, so a new alternative makes the compiler name
+// each place to handle (docs/contacts.md, "Adding a rolling shape").
 #pragma once
 
 #include <appell/spatial.hpp>
 
+#include <span>
 #include <string>
+#include <string_view>
 #include <variant>
+#include <vector>
 
 namespace appell {
 
@@ -86,7 +94,57 @@ struct Mesh {
 using Shape = std::variant<PointShape, Sphere, Ellipsoid, Disk, Torus, SphericalCap, Box, Cylinder,
                            Mesh>;
 
-/// Short name of the alternative held ("sphere", "box", …).
+/// What a shape can carry.
+enum class ShapeRole {
+  Rolling,        ///< smooth and convex where it touches: every contact kind it has a blade for
+  Point,          ///< a body point: knife edges (with a blade direction) and sliding feet
+  CollisionOnly,  ///< edges or facets, no unique smooth contact point: no contact at all
+};
+
+/// The attributes a scene file gives for a shape, by name (io reads them from
+/// the XML element and names file, line and attribute in its errors).
+class ShapeParameters {
+ public:
+  virtual ~ShapeParameters() = default;
+  virtual bool has(const char* name) const = 0;
+  virtual double number(const char* name) const = 0;  ///< required
+  virtual Vec3 vector(const char* name) const = 0;    ///< required, three numbers
+  /// Required roll-pitch-yaw angles (URDF convention) as a rotation matrix.
+  virtual Mat3 rotation(const char* name) const = 0;
+};
+
+/// One alternative of `Shape`: its names, what it is, what it can carry and
+/// how a scene file declares it (`<contact shape="name" …/>`).
+struct ShapeType {
+  const char* name;                   ///< canonical, as in a scene file: "sphere", "cap", …
+  std::vector<const char*> aliases;   ///< other scene-file spellings ("hemisphere")
+  const char* description;
+  ShapeRole role;
+  /// Not rolling: why, and what to use instead.
+  const char* cannot_roll;
+  /// Attributes of `shape="name"`; empty when a scene file cannot declare it.
+  std::vector<const char*> parameters;
+  /// Those attributes with example values, as written in a scene file (docs, tests).
+  const char* example;
+  /// Builds the shape from those attributes (null when not declarable). Throws
+  /// std::invalid_argument naming the attribute; validateShape() still applies.
+  Shape (*make)(const ShapeParameters&);
+};
+
+/// One entry per alternative, in the variant's order (entry k describes
+/// alternative k): the one list of shape names.
+std::span<const ShapeType> shapeTable();
+/// The entry of the alternative held.
+const ShapeType& shapeType(const Shape& shape);
+/// The entry `text` names (canonical name or alias, '-' = '_'), or nullptr.
+const ShapeType* findShapeType(std::string_view text);
+/// "sphere, ellipsoid, …": the canonical names of the rolling shapes.
+std::string rollingShapeNames();
+/// Every name and alias `shape="…"` accepts in a scene file (the entries with
+/// a `make`), for error messages: "sphere, …, cap (hemisphere, spherical_cap), …".
+std::string declarableShapeNames();
+
+/// Canonical name of the alternative held ("sphere", "box", …).
 const char* shapeName(const Shape& shape);
 
 /// True when the shape can carry a rolling contact; otherwise `why` (when not
@@ -95,6 +153,10 @@ bool canRoll(const Shape& shape, std::string* why = nullptr);
 
 /// True for shapes the exact contact geometry handles (rolling shapes and points).
 bool isSmoothContactShape(const Shape& shape);
+
+/// The wheel axle of a disk or torus (its wheel plane is a knife edge's
+/// blade), nullptr for every other shape.
+const Vec3* wheelAxis(const Shape& shape);
 
 /// Throws std::invalid_argument naming the shape and the bad parameter
 /// (non-positive or non-finite radius, zero axis, non-orthonormal orientation,

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <appell/constraint_set.hpp>
+#include <appell/name_table.hpp>
 
 #include <memory>
 #include <string>
@@ -25,8 +26,13 @@
 namespace appell {
 
 enum class Formulation { Tree, Multipliers, Appell };
-const char* toString(Formulation f);  ///< "tree", "kkt", "appell"
-/// Parses "tree", "kkt"/"multipliers", "appell"/"maggi"; throws std::invalid_argument otherwise.
+/// Every formulation with its names ("tree", "kkt"/"multipliers",
+/// "appell"/"maggi"): the one list that parsing, error messages, the scene
+/// format and the command-line help read.
+std::span<const NamedValue<Formulation>> formulationTable();
+const char* toString(Formulation f);  ///< the canonical name
+/// Parses any name or alias of formulationTable(); throws std::invalid_argument
+/// listing them all otherwise.
 Formulation formulationFromString(const std::string& name);
 
 struct SolverOptions {

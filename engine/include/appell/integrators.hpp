@@ -11,6 +11,7 @@
 #pragma once
 
 #include <appell/model.hpp>
+#include <appell/name_table.hpp>
 
 #include <functional>
 #include <memory>
@@ -27,9 +28,12 @@ class AccelerationField {
 };
 
 enum class IntegratorType { SymplecticEuler, RK4, DormandPrince54 };
-const char* toString(IntegratorType type);
-/// Parses "euler"/"symplectic-euler", "rk4", "dopri5"/"dormand-prince"; throws
-/// std::invalid_argument naming the accepted values otherwise.
+/// Every integrator with its names ("euler", "rk4", "dopri5" and their aliases):
+/// the one list that parsing, error messages and the command-line help read.
+std::span<const NamedValue<IntegratorType>> integratorTable();
+const char* toString(IntegratorType type);  ///< the canonical name
+/// Parses any name or alias of integratorTable(); throws std::invalid_argument
+/// listing them all otherwise.
 IntegratorType integratorFromString(const std::string& name);
 
 struct IntegratorOptions {

@@ -6,23 +6,21 @@
 
 namespace appell {
 
-const char* toString(IntegratorType type) {
-  switch (type) {
-    case IntegratorType::SymplecticEuler: return "euler";
-    case IntegratorType::RK4: return "rk4";
-    case IntegratorType::DormandPrince54: return "dopri5";
-  }
-  return "?";
+std::span<const NamedValue<IntegratorType>> integratorTable() {
+  static const NamedValue<IntegratorType> table[] = {
+      {IntegratorType::SymplecticEuler, "euler", {"symplectic_euler", "semi_implicit_euler"},
+       "symplectic (semi-implicit) Euler, fixed step, order 1"},
+      {IntegratorType::RK4, "rk4", {}, "classic Runge–Kutta–Munthe-Kaas, fixed step, order 4"},
+      {IntegratorType::DormandPrince54, "dopri5", {"dormand_prince", "rk45"},
+       "Dormand–Prince 5(4), adaptive step (tol), order 5"},
+  };
+  return table;
 }
 
+const char* toString(IntegratorType type) { return entryOf(integratorTable(), type).name; }
+
 IntegratorType integratorFromString(const std::string& name) {
-  if (name == "euler" || name == "symplectic-euler" || name == "semi-implicit-euler")
-    return IntegratorType::SymplecticEuler;
-  if (name == "rk4") return IntegratorType::RK4;
-  if (name == "dopri5" || name == "dormand-prince" || name == "rk45")
-    return IntegratorType::DormandPrince54;
-  throw std::invalid_argument("unknown integrator '" + name +
-                              "' (expected one of: euler, rk4, dopri5)");
+  return parseName(integratorTable(), name, "integrator");
 }
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type, const Model& model,

@@ -7,21 +7,19 @@
 
 namespace appell {
 
-const char* toString(Formulation f) {
-  switch (f) {
-    case Formulation::Tree: return "tree";
-    case Formulation::Multipliers: return "kkt";
-    case Formulation::Appell: return "appell";
-  }
-  return "?";
+std::span<const NamedValue<Formulation>> formulationTable() {
+  static const NamedValue<Formulation> table[] = {
+      {Formulation::Tree, "tree", {}, "Gauss' principle on the kinematic tree, O(n + m) (default)"},
+      {Formulation::Multipliers, "kkt", {"multipliers"}, "dense Lagrange multipliers (KKT), the reference"},
+      {Formulation::Appell, "appell", {"maggi"}, "dense Appell/Maggi equations on the null space"},
+  };
+  return table;
 }
 
+const char* toString(Formulation f) { return entryOf(formulationTable(), f).name; }
+
 Formulation formulationFromString(const std::string& name) {
-  if (name == "tree") return Formulation::Tree;
-  if (name == "kkt" || name == "multipliers") return Formulation::Multipliers;
-  if (name == "appell" || name == "maggi") return Formulation::Appell;
-  throw std::invalid_argument("unknown formulation '" + name +
-                              "' (expected one of: tree, kkt, multipliers, appell, maggi)");
+  return parseName(formulationTable(), name, "formulation");
 }
 
 

@@ -13,7 +13,6 @@
 #include <appell/model.hpp>
 
 #include <array>
-#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -65,19 +64,10 @@ struct LinkGeometry {
 /// document order.
 std::vector<Shape> collisionShapes(const LinkGeometry& link);
 
-/// One declared contact, index-aligned with Scene::constraints. The shape is
-/// in the body frame (a link's frame: every link is a body).
-struct ContactInfo {
-  std::string name;
-  std::string link;
-  int body = -1;
-  ContactKind kind = ContactKind::Rolling;
-  std::string support;            ///< Support::name
-  int support_index = -1;         ///< into Scene::supports
-  Shape shape;
-  Vec3 blade_direction = Vec3::Zero();  ///< knife edge on a point: body frame
-  /// Friction coefficient for the friction check (∞: not checked).
-  double mu = std::numeric_limits<double>::infinity();
+/// Where a declared contact came from in the file. The contact itself —
+/// kind, body, shape, support, blade, μ — is described once, by its
+/// constraint (Scene::contacts[k]->spec()).
+struct ContactOrigin {
   /// Where the shape came from: "explicit" or "collision[k] (<type>)".
   std::string shape_source;
   int line = 0;                   ///< line of the <contact> element
@@ -85,18 +75,22 @@ struct ContactInfo {
 
 /// Defaults for running the scene; the command line may override them.
 struct SimulationSettings {
-  std::string integrator = "rk4";  ///< integratorFromString() accepts it
+  std::string integrator = "rk4";  ///< a canonical name of integratorTable()
   double dt = 1e-3;                ///< fixed step (and first step of adaptive methods)
   double tol = 1e-8;               ///< adaptive methods: relative tolerance
   double duration = 1.0;
-  std::string formulation = "tree";  ///< "tree" | "kkt" | "appell"
+  std::string formulation = "tree";  ///< a canonical name of formulationTable()
 };
 
 struct Scene {
   Model model;
   /// One constraint per contact, in the order of `contacts`.
   ConstraintList constraints;
-  std::vector<ContactInfo> contacts;
+  /// The declared contacts in document order: the same objects as `constraints`
+  /// (a contact's description is its spec(); the link is
+  /// model.body_names[contact->bodyA()]).
+  std::vector<std::shared_ptr<const ShapeContact>> contacts;
+  std::vector<ContactOrigin> contact_origins;  ///< index-aligned with `contacts`
   std::vector<Support> supports;
   VecX q0, v0;                     ///< initial state (nq, nv)
   VecX tau;                        ///< constant generalized forces (nv), from <effort>

@@ -1,6 +1,7 @@
 // Parsing of the `<appell>` scene block (docs/scene-format.md).
 #include "scene/block.hpp"
 
+#include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
 
 #include <algorithm>
@@ -104,24 +105,35 @@ SupportDecl parseSupport(const XmlSource& src, const TiXmlElement* e, const std:
 }
 
 ContactKind parseKind(const XmlSource& src, const TiXmlElement* e) {
-  std::string k = text(e, "kind", "rolling");
-  std::replace(k.begin(), k.end(), '-', '_');
-  if (k == "rolling_no_spin") k = "rolling_without_spin";
   try {
-    return contactKindFromString(k);
-  } catch (const std::invalid_argument&) {
-    fail(src, e, "unknown contact kind '" + text(e, "kind", "") +
-                     "' (known: rolling, rolling_without_spin, knife_edge, sliding)");
+    return contactKindFromString(text(e, "kind", "rolling"));
+  } catch (const std::invalid_argument& err) {
+    fail(src, e, err.what());
   }
 }
 
-// Pose of an explicit shape in the link frame: xyz (centre) and, for the
-// ellipsoid, rpy (its semi-axes along the rotated x, y, z).
+// A shape's attributes, read from the <contact> element (errors name file,
+// line and attribute).
+class XmlShapeParameters : public ShapeParameters {
+ public:
+  XmlShapeParameters(const XmlSource& src, const TiXmlElement* e) : src_(src), e_(e) {}
+  bool has(const char* name) const override { return io::has(e_, name); }
+  double number(const char* name) const override { return io::number(src_, e_, name); }
+  Vec3 vector(const char* name) const override { return vec3(src_, e_, name); }
+  Mat3 rotation(const char* name) const override { return rpyToMatrix(vec3(src_, e_, name)); }
+
+ private:
+  const XmlSource& src_;
+  const TiXmlElement* e_;
+};
+
+// An explicit shape, in the link frame: `point="x y z"`, or `shape="name"`
+// with the attributes shapeTable() lists for it.
 std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement* e) {
   const bool has_shape = has(e, "shape"), has_point = has(e, "point");
   if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
   static const char* const kCommon[] = {"name", "link", "kind", "support", "mu", "direction"};
-  auto allow = [&](std::initializer_list<const char*> extra) {
+  auto allow = [&](const std::vector<const char*>& extra) {
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string n = a->Name();
       bool ok = false;
@@ -142,74 +154,53 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
     allow({"collision", "tyre_radius"});
     return std::nullopt;
   }
-  const std::string type = text(src, e, "shape");
-  if (type == "sphere") allow({"shape", "radius", "xyz"});
-  if (type == "ellipsoid") allow({"shape", "semi_axes", "xyz", "rpy"});
-  if (type == "disk" || type == "hemisphere") allow({"shape", "radius", "xyz", "axis"});
-  if (type == "torus") allow({"shape", "radius", "tyre_radius", "xyz", "axis"});
-  if (type == "cap") allow({"shape", "radius", "xyz", "axis", "half_angle"});
-  const Vec3 c = vec3(src, e, "xyz", Vec3::Zero());
-  if (type == "sphere") return Shape{Sphere{positive(src, e, "radius"), c}};
-  if (type == "ellipsoid") {
-    Ellipsoid el;
-    el.semi_axes = vec3(src, e, "semi_axes");
-    if (el.semi_axes.minCoeff() <= 0) fail(src, e, "'semi_axes' must be positive");
-    el.centre = c;
-    el.orientation = rpyToMatrix(vec3(src, e, "rpy", Vec3::Zero()));
-    return Shape{el};
+  const std::string name = text(src, e, "shape");
+  const ShapeType* type = findShapeType(name);
+  if (type && !type->make)
+    fail(src, e, "shape '" + name + "' cannot carry a contact: " + type->cannot_roll);
+  if (!type) fail(src, e, "unknown shape '" + name + "' (known: " + declarableShapeNames() + ")");
+  std::vector<const char*> attributes = type->parameters;
+  attributes.push_back("shape");
+  allow(attributes);
+  try {
+    return type->make(XmlShapeParameters(src, e));
+  } catch (const std::invalid_argument& err) {
+    fail(src, e, err.what());
   }
-  if (type == "disk") return Shape{Disk{positive(src, e, "radius"), c, unitVector(src, e, "axis", Vec3::UnitZ())}};
-  if (type == "torus") {
-    // `radius` is the wheel's outer radius, as for a cylinder collision with
-    // a tyre: the tube's centre circle has radius − tyre_radius.
-    Torus t;
-    const double outer = positive(src, e, "radius");
-    t.minor = positive(src, e, "tyre_radius");
-    if (t.minor >= outer) fail(src, e, "'tyre_radius' must be smaller than 'radius'");
-    t.major = outer - t.minor;
-    t.centre = c;
-    t.axis = unitVector(src, e, "axis", Vec3::UnitZ());
-    return Shape{t};
-  }
-  if (type == "hemisphere" || type == "cap") {
-    SphericalCap cap;
-    cap.radius = positive(src, e, "radius");
-    cap.centre = c;
-    cap.axis = unitVector(src, e, "axis", -Vec3::UnitZ());
-    cap.half_angle = type == "cap" ? positive(src, e, "half_angle") : M_PI / 2;
-    return Shape{cap};
-  }
-  fail(src, e, "unknown shape '" + type + "' (known: sphere, ellipsoid, disk, torus, hemisphere, cap)");
 }
 
 ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
   ContactDecl d;
   d.element = e;
-  d.name = text(src, e, "name");
-  if (d.name.empty()) fail(src, e, "empty contact name");
+  ContactOptions& options = d.spec.options;
+  options.name = text(src, e, "name");
+  if (options.name.empty()) fail(src, e, "empty contact name");
   d.link = text(src, e, "link");
   d.support = text(src, e, "support");
-  d.kind = parseKind(src, e);
-  d.shape = parseExplicitShape(src, e);
-  if (has(e, "direction")) {
-    d.has_direction = true;
-    d.blade_direction = vec3(src, e, "direction");
-    if (d.blade_direction.norm() < 1e-12) fail(src, e, "knife edge 'direction' is a zero vector");
+  d.spec.kind = parseKind(src, e);
+  const std::optional<Shape> shape = parseExplicitShape(src, e);
+  d.explicit_shape = shape.has_value();
+  if (shape) d.spec.shape = *shape;
+  const bool has_direction = has(e, "direction");
+  if (has_direction) {
+    options.blade_direction = vec3(src, e, "direction");
+    if (options.blade_direction.norm() < 1e-12) fail(src, e, "knife edge 'direction' is a zero vector");
   }
-  if (has(e, "tyre_radius") && !(d.shape && std::holds_alternative<Torus>(*d.shape))) {
-    if (d.shape) fail(src, e, "'tyre_radius' applies to a cylinder collision or shape=\"torus\"");
+  if (has(e, "tyre_radius") && !(shape && std::holds_alternative<Torus>(*shape))) {
+    if (shape) fail(src, e, "'tyre_radius' applies to a cylinder collision or shape=\"torus\"");
     d.tyre_radius = positive(src, e, "tyre_radius");
   }
   d.collision = text(e, "collision", "");
   if (has(e, "mu")) {
-    d.mu = number(src, e, "mu");
-    if (d.mu < 0) fail(src, e, "friction coefficient 'mu' must not be negative");
+    d.spec.mu = number(src, e, "mu");
+    if (d.spec.mu < 0) fail(src, e, "friction coefficient 'mu' must not be negative");
   }
-  if (d.kind == ContactKind::KnifeEdge && d.shape && std::holds_alternative<PointShape>(*d.shape) &&
-      !d.has_direction)
+  if (d.spec.kind == ContactKind::KnifeEdge && shape && shapeType(*shape).role == ShapeRole::Point &&
+      !has_direction)
     fail(src, e, "a knife edge on a point needs a blade 'direction'");
-  if (d.has_direction && d.kind != ContactKind::KnifeEdge)
-    fail(src, e, "'direction' is only meaningful for kind=\"knife_edge\"");
+  if (has_direction && d.spec.kind != ContactKind::KnifeEdge)
+    fail(src, e, "'direction' is only meaningful for kind=\"" +
+                     std::string(toString(ContactKind::KnifeEdge)) + "\"");
   return d;
 }
 
@@ -232,18 +223,16 @@ JointStateDecl parseJointState(const XmlSource& src, const TiXmlElement* e) {
 SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
   allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation"});
   SimulationSettings s;
-  s.integrator = text(e, "integrator", s.integrator);
+  // Both names are stored canonical ("multipliers" reads as "kkt").
   try {
-    integratorFromString(s.integrator);
+    s.integrator = toString(integratorFromString(text(e, "integrator", s.integrator)));
+    s.formulation = toString(formulationFromString(text(e, "formulation", s.formulation)));
   } catch (const std::invalid_argument& err) {
     fail(src, e, err.what());
   }
   if (has(e, "dt")) s.dt = positive(src, e, "dt");
   if (has(e, "tol")) s.tol = positive(src, e, "tol");
   if (has(e, "duration")) s.duration = positive(src, e, "duration");
-  s.formulation = text(e, "formulation", s.formulation);
-  if (s.formulation != "tree" && s.formulation != "kkt" && s.formulation != "appell")
-    fail(src, e, "unknown formulation '" + s.formulation + "' (known: tree, kkt, appell)");
   return s;
 }
 
@@ -272,7 +261,8 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
       b.supports.push_back(std::move(d));
     } else if (tag == "contact") {
       ContactDecl d = parseContact(src, e);
-      if (!contacts.insert(d.name).second) fail(src, e, "contact name '" + d.name + "' is used twice");
+      if (!contacts.insert(d.spec.options.name).second)
+        fail(src, e, "contact name '" + d.spec.options.name + "' is used twice");
       b.contacts.push_back(std::move(d));
     } else if (tag == "initial") {
       allowOnly(src, e, {});

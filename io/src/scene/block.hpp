@@ -19,14 +19,13 @@ struct SupportDecl {
 
 struct ContactDecl {
   const TiXmlElement* element = nullptr;
-  std::string name, link, support;
-  ContactKind kind = ContactKind::Rolling;
-  std::optional<Shape> shape;      ///< explicit `shape=` or `point=`
-  Vec3 blade_direction = Vec3::Zero();
-  bool has_direction = false;
+  std::string link, support;       ///< names, resolved when the model is built
+  /// kind, shape (when explicit) and options (name, blade direction, μ); the
+  /// body and the support are filled in by buildSceneContents.
+  ContactSpec spec;
+  bool explicit_shape = false;     ///< `shape=` or `point=` given
   double tyre_radius = 0;          ///< > 0: a cylinder collision is a torus rim
   std::string collision;           ///< `collision=`: name or index of the geometry to use
-  double mu = std::numeric_limits<double>::infinity();
 };
 
 struct JointStateDecl {

@@ -38,15 +38,15 @@ Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry
       break;
   }
   fail(src, c.element, label + " cannot roll: it has edges or facets, no unique contact point; "
-                       "give a smooth 'shape' (sphere, ellipsoid, disk, torus, hemisphere) or a 'point'");
+                       "give a smooth 'shape' (" + rollingShapeNames() + ") or a 'point'");
 }
 
 Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometry& geo,
                    std::string& source) {
-  if (c.shape) {
+  if (c.explicit_shape) {
     if (!c.collision.empty()) fail(src, c.element, "give either 'collision' or an explicit shape, not both");
     source = "explicit";
-    return *c.shape;
+    return c.spec.shape;
   }
   const auto& col = geo.collision;
   if (col.empty())
@@ -138,30 +138,24 @@ void buildSceneContents(const XmlSource& src, const AppellBlock& block, Scene& s
     scene.supports.push_back(std::move(support));
   }
   for (const ContactDecl& c : block.contacts) {
-    ContactInfo info;
-    info.name = c.name;
-    info.link = c.link;
-    info.body = model.bodyIndex(c.link);
-    if (info.body < 0) fail(src, c.element, "unknown link '" + c.link + "'");
-    info.kind = c.kind;
-    info.support = c.support;
-    for (int k = 0; k < static_cast<int>(scene.supports.size()); ++k)
-      if (scene.supports[k].name == c.support) info.support_index = k;
-    info.shape = contactShape(src, c, scene.geometry[info.body], info.shape_source);
-    info.blade_direction = c.blade_direction;
-    info.mu = c.mu;
-    info.line = c.element->Row();
-    ContactOptions options;
-    options.name = c.name;
-    options.blade_direction = c.blade_direction;
+    ContactSpec spec = c.spec;
+    spec.body = model.bodyIndex(c.link);
+    if (spec.body < 0) fail(src, c.element, "unknown link '" + c.link + "'");
+    for (const Support& s : scene.supports)
+      if (s.name == c.support) spec.support = s;
+    ContactOrigin origin;
+    origin.line = c.element->Row();
+    spec.shape = contactShape(src, c, scene.geometry[spec.body], origin.shape_source);
+    std::shared_ptr<const ShapeContact> contact;
     try {
-      scene.constraints.push_back(makeContact(info.kind, info.body, info.shape,
-                                              scene.supports[info.support_index], options));
+      contact = makeContact(spec);
     } catch (const std::invalid_argument& e) {
-      fail(src, c.element, std::string(e.what()) + " (shape: " + shapeName(info.shape) + " from " +
-                               info.shape_source + ")");
+      fail(src, c.element, std::string(e.what()) + " (shape: " + shapeName(spec.shape) + " from " +
+                               origin.shape_source + ")");
     }
-    scene.contacts.push_back(std::move(info));
+    scene.constraints.push_back(contact);
+    scene.contacts.push_back(std::move(contact));
+    scene.contact_origins.push_back(std::move(origin));
   }
   scene.q0 = neutralConfiguration(model);
   scene.v0 = VecX::Zero(model.nv);

@@ -27,7 +27,7 @@ std::vector<Shape> collisionShapes(const LinkGeometry& link) {
 
 int Scene::contactIndex(const std::string& name) const {
   for (int k = 0; k < static_cast<int>(contacts.size()); ++k)
-    if (contacts[k].name == name) return k;
+    if (contacts[k]->name() == name) return k;
   return -1;
 }
 
