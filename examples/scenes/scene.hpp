@@ -127,7 +127,7 @@ inline void completeVelocity(const Model& model, const ConstraintList& constrain
   const VecX dv = Eigen::CompleteOrthogonalDecomposition<MatX>(Ad).solve(-r);
   for (size_t k = 0; k < dependent.size(); ++k) v[dependent[k]] += dv[static_cast<int>(k)];
   evaluateConstraints(model, data, constraints, cd, t, q, v);
-  if (velocityResidual(cd, v) > 1e-10 * (1 + v.norm()))
+  if (velocityResidual(data, constraints, cd, v) > 1e-10 * (1 + v.norm()))
     throw std::runtime_error("completeVelocity: the chosen dependent velocities cannot satisfy "
                              "the constraints");
 }
