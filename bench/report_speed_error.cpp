@@ -62,9 +62,9 @@ Run simulate(const Scene& scene, IntegratorType type, double dt, double tol, dou
   r.energy_drift = std::abs(kineticEnergy(scene.model, data, r.q, r.v) +
                             potentialEnergy(scene.model, data, r.q) - E0) /
                    std::max(1e-12, std::abs(E0));
-  ConstraintData cd(scene.model, scene.constraints);
-  evaluateConstraints(scene.model, data, scene.constraints, cd, T, r.q, r.v);
-  r.residual = std::max(velocityResidual(cd, r.v), gapResidual(cd));
+  ConstraintData cd(scene.model, scene.constraints, DenseRows::None);
+  evaluateConstraintRows(scene.model, data, scene.constraints, cd, T, r.q, r.v);
+  r.residual = std::max(velocityResidual(data, scene.constraints, cd, r.v), gapResidual(cd));
   return r;
 }
 

@@ -68,7 +68,7 @@ int info(int argc, char** argv) {
     const int rank = static_cast<int>(qr.rank());
     std::cout << "at the initial state: rank " << rank << " of " << cd.m << " rows ("
               << cd.m - rank << " redundant), " << m.nv - rank
-              << " independent velocities; residuals |Av+b| = " << velocityResidual(cd, scene.v0)
+              << " independent velocities; residuals |Av+b| = " << velocityResidual(data, scene.constraints, cd, scene.v0)
               << ", gap = " << gapResidual(cd) << "\n";
     if (cd.singular) std::cout << "singular contact geometry: " << cd.singular_reason << "\n";
   }

@@ -68,7 +68,7 @@ struct Sim {
   // ‖A v + b‖∞ and max |gap| at (q, v, t).
   std::pair<double, double> residuals(double t, const VecX& q, const VecX& v) {
     evaluateConstraints(model, data, list, cd, t, q, v);
-    return {velocityResidual(cd, v), gapResidual(cd)};
+    return {velocityResidual(data, list, cd, v), gapResidual(cd)};
   }
 };
 

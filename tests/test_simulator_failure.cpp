@@ -18,10 +18,13 @@ namespace {
 using test::RollingBall;
 
 // Two copies of one no-slip row; while *broken, the second asks for a
-// different acceleration (κ = 1): no motion satisfies both.
+// different acceleration (κ = 1) or, at the velocity level, a different
+// velocity (b = 1, κ unchanged): no motion satisfies both.
+enum class Level { Acceleration, Velocity };
 class ContradictoryWhen final : public Constraint {
  public:
-  explicit ContradictoryWhen(std::shared_ptr<bool> broken) : broken_(std::move(broken)) {}
+  explicit ContradictoryWhen(std::shared_ptr<bool> broken, Level level = Level::Acceleration)
+      : broken_(std::move(broken)), level_(level) {}
   const std::string& name() const override { return name_; }
   int rows() const override { return 2; }
   int bodyA() const override { return 0; }
@@ -33,14 +36,18 @@ class ContradictoryWhen final : public Constraint {
     const Vec6 w = data.oMi[0].actForce(test::pointRow(Vec3(0, 0, 0.3), Vec3::UnitY()));
     out.Wa.row(0) = w.transpose();
     out.Wa.row(1) = w.transpose();
+    const bool twisted = *broken_ && level_ == Level::Acceleration;
+    const bool offset = *broken_ && level_ == Level::Velocity;
     out.kappa[0] = 0;
-    out.kappa[1] = *broken_ ? 1.0 : 0.0;
+    out.kappa[1] = twisted ? 1.0 : 0.0;
     out.b.setZero();
+    out.b[1] = offset ? 1.0 : 0.0;
     out.gap.setZero();
   }
 
  private:
   std::shared_ptr<bool> broken_;
+  Level level_;
   std::string name_ = "twin_rows";
 };
 
@@ -113,6 +120,44 @@ TEST(SimulatorFailure, ContradictoryConstraintsAreReportedByName) {
     EXPECT_NE(st.message.find("inconsistent"), std::string::npos) << st.message;
     EXPECT_NE(st.message.find("twin_rows"), std::string::npos) << st.message;
     expectSameState(sim, t, q, v);
+  }
+}
+
+// A failed velocity projection says why, whatever the formulation: the reason
+// comes through the solver interface (lastError), so the tree solver's own
+// account — which rows, found where — reaches StepStatus::message.
+TEST(SimulatorFailure, ProjectionFailureReportsTheSolversReason) {
+  const Ball b;
+  auto broken = std::make_shared<bool>(false);
+  ConstraintList c{std::make_shared<RollingBall>("contact", 0, b.R),
+                   std::make_shared<ContradictoryWhen>(broken, Level::Velocity)};
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    SCOPED_TRACE(toString(f));
+    Simulator sim(b.model, c, makeSolver(f, b.model, c), IntegratorType::RK4);
+    *broken = false;
+    sim.setState(0, b.q0, b.v0);
+    ASSERT_TRUE(sim.projectState().ok);
+    for (int k = 0; k < 5; ++k) ASSERT_TRUE(sim.step(1e-3).ok);
+    const double t = sim.time();
+    const VecX q = sim.q(), v = sim.v();
+    // b does not enter the accelerations: the step integrates, then the
+    // velocity projection meets rows no velocity satisfies.
+    *broken = true;
+    StepStatus st = sim.step(1e-3);
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("velocity projection failed: inconsistent"), std::string::npos)
+        << st.message;
+    EXPECT_NE(st.message.find("twin_rows"), std::string::npos) << st.message;
+    expectSameState(sim, t, q, v);
+    // The same reason from the initial-state projection.
+    st = sim.projectState();
+    EXPECT_FALSE(st.ok);
+    EXPECT_NE(st.message.find("velocity projection failed: inconsistent"), std::string::npos)
+        << st.message;
+    EXPECT_NE(st.message.find("twin_rows"), std::string::npos) << st.message;
+    expectSameState(sim, t, q, v);
+    if (f == Formulation::Tree)  // the tree solver names where it found them
+      EXPECT_NE(st.message.find("detected at body"), std::string::npos) << st.message;
   }
 }
 

@@ -53,6 +53,7 @@ class AppellSolver final : public ConstrainedSolver {
   ~AppellSolver() override;
 
   Formulation formulation() const override { return Formulation::Appell; }
+  bool usesDenseRows() const override { return true; }
   void solve(const Model& model, Data& data, const ConstraintList& constraints,
              ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
              ConstrainedResult& out) override;
@@ -69,15 +70,14 @@ class AppellSolver final : public ConstrainedSolver {
   /// CoordinatePartition: how often the dependent velocities were re-chosen
   /// (the first choice is not counted), whether the last solve re-chose them,
   /// the condition number that triggered it and of the current partition.
-  int partitionChanges() const;
+  int partitionChanges() const override;
   bool partitionChangedLastSolve() const;
   double partitionCondition() const;
   /// Dependent velocity indices of the current partition (empty for Orthonormal).
   std::vector<int> dependentVelocities() const;
   /// Human-readable account of the last re-choice ("" if none). Allocates.
   std::string partitionMessage() const;
-  /// Error of the last projectVelocity() that returned false.
-  const std::string& lastError() const { return last_error_; }
+  const std::string& lastError() const override { return last_error_; }
 
  private:
   struct Impl;

@@ -55,16 +55,26 @@ class ConstrainedSolver {
  public:
   virtual ~ConstrainedSolver() = default;
   virtual Formulation formulation() const = 0;
+  /// Whether solve() and projectVelocity() assemble the dense A (m × nv): then
+  /// the ConstraintData they are given needs DenseRows::Sized storage. The tree
+  /// solver reads only the rows.
+  virtual bool usesDenseRows() const = 0;
   /// Accelerations and reactions at (t, q, v) under joint forces τ (gravity from
-  /// the model). `cdata` must hold evaluateConstraints(t, q, v); `data` is workspace.
+  /// the model). `cdata` must hold the rows at (t, q, v) (evaluateConstraintRows;
+  /// a dense solver assembles A and abias itself); `data` is workspace.
   virtual void solve(const Model& model, Data& data, const ConstraintList& constraints,
                      ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
                      ConstrainedResult& out) = 0;
   /// Impulse solve for drift control: v ← argmin ‖v⁺ − v‖_M subject to A v⁺ + b = 0,
-  /// with A, b from `cdata` (evaluated at q). Writes the impulses (m) to `impulse`.
-  /// Returns false (v untouched) when the rows are inconsistent.
+  /// with the rows in `cdata` evaluated at q. Writes the impulses (m) to `impulse`.
+  /// Returns false (v untouched, lastError() says why) when the rows are inconsistent.
   virtual bool projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,
                                ConstraintData& cdata, const VecX& q, VecX& v, VecX& impulse) = 0;
+  /// Why the last solve() or projectVelocity() failed (empty after a success).
+  virtual const std::string& lastError() const = 0;
+  /// How often the solver re-chose which velocities are dependent (only the
+  /// Appell solver's coordinate partition does; 0 for the others).
+  virtual int partitionChanges() const { return 0; }
 };
 
 /// Builds the solver for a formulation, with its workspace sized for this system.

@@ -1,7 +1,20 @@
-// All declared constraints of a system, evaluated together into the dense
-// Pfaffian form the reference solvers use:
+// All declared constraints of a system, in two forms.
+//
+// Rows. Each constraint writes its block at (q, v, t) (constraint.hpp): world-
+// frame spatial covectors on one or two bodies' spatial velocities,
+//     wₐ·Vₐ − w_b·V_b + b = 0,      wₐ·aₐ − w_b·a_b + κ = 0,
+// or, for jointSpace() constraints, rows over v. Evaluating the rows costs
+// O(n) kinematics plus O(m); it is all the tree solver reads, and the
+// velocity residual ‖A v + b‖∞ follows from the rows and the body velocities
+// (Vₐ = ᵒXₐ Vₐ^body) without ever forming A.
+//
+// Dense form. The reference solvers (KKT, Appell/Maggi), equilibria and
+// linearization read the Pfaffian form over the generalized velocities,
 //     A(q, t) v + b(q, t) = 0,      A v̇ + abias = 0,   abias = Ȧ v + ḃ,
-// while keeping each constraint's body-local block for the tree kernel.
+// assembled from the rows with the world-frame body Jacobians, V = J v:
+//     A = Wₐ Jₐ − W_b J_b,      abias = κ + Wₐ J̇ₐv − W_b J̇_b v
+// (J̇v is the body's spatial acceleration at v̇ = 0). That is O(m·nv) per
+// evaluation, so it is a separate step, done only by those who need it.
 #pragma once
 
 #include <appell/constraint.hpp>
@@ -13,29 +26,62 @@ namespace appell {
 
 using ConstraintList = std::vector<std::shared_ptr<const Constraint>>;
 
-struct ConstraintData {
-  ConstraintData(const Model& model, const ConstraintList& constraints);
+/// Whether a ConstraintData carries storage for the dense form (m × nv A).
+enum class DenseRows { Sized, None };
 
+struct ConstraintData {
+  /// Sizes every buffer once; the dense part only with DenseRows::Sized.
+  ConstraintData(const Model& model, const ConstraintList& constraints,
+                 DenseRows dense = DenseRows::Sized);
+
+  // Rows (evaluateConstraintRows).
   int m = 0;                       ///< total rows
   std::vector<int> offset;         ///< first row of each constraint
   std::vector<RowBlock> blocks;    ///< per constraint, as evaluated
-  MatX A;                          ///< m × nv
-  VecX b, abias;                   ///< m
+  VecX b;                          ///< m, velocity offsets of the rows
   VecX gap;                        ///< m, holonomic gaps (0 for other rows)
   std::vector<char> holonomic;     ///< m, row is ġ of a gap
   std::vector<int> row_constraint; ///< m, owning constraint
   bool singular = false;           ///< some constraint reported singular geometry
   std::string singular_reason;     ///< "<constraint>: <reason>" of the first one
-  MatX J;                          ///< 6 × nv scratch
+
+  // Dense form (assembleDenseRows), empty unless sized.
+  bool has_dense = false;          ///< the dense storage below is sized
+  MatX A;                          ///< m × nv
+  VecX abias;                      ///< m, Ȧv + ḃ
+  MatX J;                          ///< 6 × nv scratch (body Jacobian)
 };
 
-/// Evaluates every constraint at (q, v, t) into `cdata` (blocks, A, b, abias, gaps).
-/// Leaves `data` holding forwardKinematics(q, v, 0): data.a are the bias accelerations J̇v.
+/// Evaluates every constraint's rows at (q, v, t): blocks, b, gaps, singular
+/// flags. Leaves `data` holding forwardKinematics(q, v, 0) (data.a = J̇v).
+void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList& constraints,
+                            ConstraintData& cdata, double t, const VecX& q, const VecX& v);
+
+/// Assembles A and abias from the rows in `cdata`. `data` must hold
+/// forwardKinematics(q, v, 0) at the rows' (q, v), as evaluateConstraintRows
+/// leaves it. Throws std::logic_error when `cdata` has no dense storage.
+void assembleDenseRows(const Model& model, const Data& data, const ConstraintList& constraints,
+                       ConstraintData& cdata);
+
+/// A and abias of one constraint's rows (rows × nv, rows), from its evaluated
+/// block; `J` is 6 × nv scratch. `data` as for assembleDenseRows.
+void assembleConstraintRows(const Model& model, const Data& data, const Constraint& constraint,
+                            const RowBlock& block, MatX& J, Eigen::Ref<MatX> A,
+                            Eigen::Ref<VecX> abias);
+
+/// Rows and dense form together: evaluateConstraintRows, then assembleDenseRows.
 void evaluateConstraints(const Model& model, Data& data, const ConstraintList& constraints,
                          ConstraintData& cdata, double t, const VecX& q, const VecX& v);
 
-/// ‖A v + b‖∞ and max |gap| of the last evaluation.
-double velocityResidual(const ConstraintData& cdata, const VecX& v);
+/// ‖A v + b‖∞ from the rows and the body velocities: `data` must hold
+/// forwardKinematics(q, v) at the rows' q and this v (as evaluateConstraintRows
+/// at (q, v) leaves it). O(m); A is not needed.
+double velocityResidual(const Data& data, const ConstraintList& constraints,
+                        const ConstraintData& cdata, const VecX& v);
+/// The same at any v: recomputes forwardKinematics(q, v) into `data` first.
+double velocityResidual(const Model& model, Data& data, const ConstraintList& constraints,
+                        const ConstraintData& cdata, const VecX& q, const VecX& v);
+/// max |gap| of the last evaluation.
 double gapResidual(const ConstraintData& cdata);
 
 }  // namespace appell

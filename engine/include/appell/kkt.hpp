@@ -33,6 +33,7 @@ class KktSolver final : public ConstrainedSolver {
   ~KktSolver() override;
 
   Formulation formulation() const override { return Formulation::Multipliers; }
+  bool usesDenseRows() const override { return true; }
   void solve(const Model& model, Data& data, const ConstraintList& constraints,
              ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
              ConstrainedResult& out) override;
@@ -42,8 +43,7 @@ class KktSolver final : public ConstrainedSolver {
                        ConstraintData& cdata, const VecX& q, VecX& v, VecX& impulse) override;
 
   const SolverOptions& options() const { return options_; }
-  /// Error of the last projectVelocity() that returned false.
-  const std::string& lastError() const { return last_error_; }
+  const std::string& lastError() const override { return last_error_; }
 
  private:
   struct Impl;

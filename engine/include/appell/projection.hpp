@@ -3,7 +3,8 @@
 // An integrator keeps A v + b = 0 and g(q, t) = 0 only up to its truncation
 // error. After every step (DESIGN.md §1, "Drift"):
 //  1. positions — Newton on the holonomic gaps g(q, t) = 0 (rows flagged
-//     holonomic, gaps from ConstraintData::gap). Each iteration takes the
+//     holonomic, gaps from ConstraintData::gap; A_hol assembled from those rows
+//     only, A_hol = Wₐ Jₐ − W_b J_b). Each iteration takes the
 //     step δ of least M-norm in velocity space with A_hol δ = −g (rank-aware:
 //     redundant gap rows are fine, contradictory ones an error) and moves
 //     q ← retract(q, localRate(q, 0, δ)), so quaternions stay unit by
@@ -54,8 +55,10 @@ class PositionProjector {
   PositionProjector& operator=(PositionProjector&&) noexcept;
 
   /// Drives the holonomic gaps at time t to zero by moving q. On return `cdata`
-  /// holds evaluateConstraints(t, q, 0) at the final q (A and b are valid for
-  /// the velocity projection; abias is not). On failure q is left unchanged.
+  /// holds the rows evaluateConstraintRows(t, q, 0) at the final q (their
+  /// covectors and b are what the velocity projection needs; κ is not). Only the
+  /// holonomic rows are assembled over v, into the projector's own workspace:
+  /// `cdata` needs no dense storage. On failure q is left unchanged.
   PositionProjectionResult project(const Model& model, Data& data,
                                    const ConstraintList& constraints, ConstraintData& cdata,
                                    double t, VecX& q);
@@ -76,7 +79,7 @@ PositionProjectionResult projectPositions(const Model& model, Data& data,
 struct StateProjectionResult {
   bool ok = true;
   PositionProjectionResult position;
-  double velocity_residual = 0;  ///< ‖A v + b‖∞ after
+  double velocity_residual = 0;  ///< ‖A v + b‖∞ after (from the rows)
   double gap_residual = 0;       ///< max |g| after
   std::string error;
 };
@@ -89,12 +92,17 @@ StateProjectionResult projectState(const Model& model, Data& data,
                                    double t, VecX& q, VecX& v, VecX& impulse);
 
 /// Baumgarte stabilisation (option only): abias ← abias + 2α(A v + b) + β² g,
-/// so the constraints obey ë + 2αė + β²e = 0 instead of ë = 0.
+/// so the constraints obey ë + 2αė + β²e = 0 instead of ë = 0. Applied to the
+/// rows (κ, or Ȧv + ḃ of joint-space rows), so every formulation sees it; also
+/// to the dense abias when `cdata` has dense storage. `data` must hold
+/// forwardKinematics(q, v) of the rows' evaluation (as evaluateConstraintRows
+/// leaves it).
 struct BaumgarteOptions {
   bool enabled = false;
   double alpha = 0;
   double beta = 0;
 };
-void applyBaumgarte(ConstraintData& cdata, const VecX& v, double alpha, double beta);
+void applyBaumgarte(const Data& data, const ConstraintList& constraints, ConstraintData& cdata,
+                    const VecX& v, double alpha, double beta);
 
 }  // namespace appell

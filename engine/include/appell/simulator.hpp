@@ -123,7 +123,7 @@ class Simulator {
   JointForces tau_fn_;
 
   double t_ = 0, t_prev_ = 0;
-  VecX q_, v_, q_prev_, v_prev_, tau_, impulse_, row_buf_;
+  VecX q_, v_, q_prev_, v_prev_, tau_, impulse_;
   ConstrainedResult result_;
   PositionProjectionResult projection_;
   double kinetic_ = 0, potential_ = 0, velocity_residual_ = 0, gap_residual_ = 0;

@@ -48,6 +48,8 @@ class TreeSolver : public ConstrainedSolver {
   TreeSolver& operator=(const TreeSolver&) = delete;
 
   Formulation formulation() const override { return Formulation::Tree; }
+  /// Reads only the rows (blocks): A is never formed.
+  bool usesDenseRows() const override { return false; }
 
   void solve(const Model& model, Data& data, const ConstraintList& constraints,
              ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
@@ -62,8 +64,7 @@ class TreeSolver : public ConstrainedSolver {
   /// Number of loop-closing rows (two moving bodies or joint-space rows)
   /// handled by the Schur complement.
   int loopRows() const;
-  /// Why the last projectVelocity() returned false (empty otherwise).
-  const std::string& lastError() const;
+  const std::string& lastError() const override;
 
  private:
   std::unique_ptr<detail::TreeWorkspace> ws_;

@@ -3,12 +3,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace appell {
 
-ConstraintData::ConstraintData(const Model& model, const ConstraintList& constraints)
-    : blocks(constraints.size()), J(MatX::Zero(6, model.nv)) {
+ConstraintData::ConstraintData(const Model& model, const ConstraintList& constraints,
+                               DenseRows dense)
+    : blocks(constraints.size()) {
   for (size_t k = 0; k < constraints.size(); ++k) {
+    if (!constraints[k]) throw std::invalid_argument("constraint list holds a null constraint");
     offset.push_back(m);
     constraints[k]->reserve(model, blocks[k]);
     for (int r = 0; r < constraints[k]->rows(); ++r) {
@@ -17,14 +20,18 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
     }
     m += constraints[k]->rows();
   }
-  A = MatX::Zero(m, model.nv);
   b = VecX::Zero(m);
-  abias = VecX::Zero(m);
   gap = VecX::Zero(m);
+  if (dense == DenseRows::Sized) {
+    has_dense = true;
+    A = MatX::Zero(m, model.nv);
+    abias = VecX::Zero(m);
+    J = MatX::Zero(6, model.nv);
+  }
 }
 
-void evaluateConstraints(const Model& model, Data& data, const ConstraintList& constraints,
-                         ConstraintData& cd, double t, const VecX& q, const VecX& v) {
+void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList& constraints,
+                            ConstraintData& cd, double t, const VecX& q, const VecX& v) {
   data.ddq.setZero();
   forwardKinematics(model, data, q, v, data.ddq);
   cd.singular = false;
@@ -39,35 +46,89 @@ void evaluateConstraints(const Model& model, Data& data, const ConstraintList& c
     }
     const int o = cd.offset[k], m = c.rows();
     if (c.jointSpace()) {
-      cd.A.middleRows(o, m) = blk.A_joint;
       cd.b.segment(o, m) = blk.b_joint;
-      cd.abias.segment(o, m) = blk.abias_joint;
       // Holonomic joint-space rows report their gaps in blk.gap (≤ 6 rows).
       if (blk.gap.size() == m) cd.gap.segment(o, m) = blk.gap;
       else cd.gap.segment(o, m).setZero();
-      continue;
-    }
-    // Rows over body velocities: A = Wₐ Jₐ − W_b J_b, abias = κ + Wₐ J̇ₐv − W_b J̇_b v.
-    cd.b.segment(o, m) = blk.b;
-    cd.abias.segment(o, m) = blk.kappa;
-    cd.gap.segment(o, m) = blk.gap;
-    cd.A.middleRows(o, m).setZero();
-    const int bodies[2] = {c.bodyA(), c.bodyB()};
-    for (int s = 0; s < 2; ++s) {
-      if (bodies[s] < 0) continue;
-      const double sign = s == 0 ? 1.0 : -1.0;
-      const RowMatrix6& W = s == 0 ? blk.Wa : blk.Wb;
-      spatialJacobianWorld(model, data, bodies[s], cd.J);
-      cd.A.middleRows(o, m).noalias() += sign * W * cd.J;
-      cd.abias.segment(o, m).noalias() += sign * W * spatialAccelerationWorld(data, bodies[s]);
+    } else {
+      cd.b.segment(o, m) = blk.b;
+      cd.gap.segment(o, m) = blk.gap;
     }
   }
 }
 
-double velocityResidual(const ConstraintData& cd, const VecX& v) {
+void assembleConstraintRows(const Model& model, const Data& data, const Constraint& c,
+                            const RowBlock& blk, MatX& J, Eigen::Ref<MatX> A,
+                            Eigen::Ref<VecX> abias) {
+  if (c.jointSpace()) {
+    A = blk.A_joint;
+    abias = blk.abias_joint;
+    return;
+  }
+  // A = Wₐ Jₐ − W_b J_b,  abias = κ + Wₐ J̇ₐv − W_b J̇_b v.
+  const int m = c.rows();
+  A.setZero();
+  abias = blk.kappa.head(m);
+  const int bodies[2] = {c.bodyA(), c.bodyB()};
+  for (int s = 0; s < 2; ++s) {
+    if (bodies[s] < 0) continue;
+    const double sign = s == 0 ? 1.0 : -1.0;
+    const RowMatrix6& W = s == 0 ? blk.Wa : blk.Wb;
+    spatialJacobianWorld(model, data, bodies[s], J);
+    A.noalias() += sign * W * J;
+    abias.noalias() += sign * W * spatialAccelerationWorld(data, bodies[s]);
+  }
+}
+
+void assembleDenseRows(const Model& model, const Data& data, const ConstraintList& constraints,
+                       ConstraintData& cd) {
+  if (!cd.has_dense)
+    throw std::logic_error(
+        "assembleDenseRows: this ConstraintData was built without dense storage "
+        "(DenseRows::None)");
+  for (size_t k = 0; k < constraints.size(); ++k) {
+    const int o = cd.offset[k], m = constraints[k]->rows();
+    assembleConstraintRows(model, data, *constraints[k], cd.blocks[k], cd.J, cd.A.middleRows(o, m),
+                           cd.abias.segment(o, m));
+  }
+}
+
+void evaluateConstraints(const Model& model, Data& data, const ConstraintList& constraints,
+                         ConstraintData& cd, double t, const VecX& q, const VecX& v) {
+  evaluateConstraintRows(model, data, constraints, cd, t, q, v);
+  assembleDenseRows(model, data, constraints, cd);
+}
+
+double velocityResidual(const Data& data, const ConstraintList& constraints,
+                        const ConstraintData& cd, const VecX& v) {
   double r = 0;  // row by row: no temporary vector
-  for (int i = 0; i < cd.m; ++i) r = std::max(r, std::abs(cd.A.row(i).dot(v) + cd.b[i]));
+  for (size_t k = 0; k < constraints.size(); ++k) {
+    const Constraint& c = *constraints[k];
+    const RowBlock& blk = cd.blocks[k];
+    const int o = cd.offset[k], m = c.rows();
+    if (c.jointSpace()) {
+      for (int i = 0; i < m; ++i)
+        r = std::max(r, std::abs(blk.A_joint.row(i).dot(v) + cd.b[o + i]));
+      continue;
+    }
+    // wₐ·Vₐ − w_b·V_b + b with world-frame body velocities V = ᵒX V^body.
+    const int a = c.bodyA(), bb = c.bodyB();
+    const Vec6 Va = a >= 0 ? Vec6(data.oMi[a].act(data.v[a])) : Vec6::Zero();
+    const Vec6 Vb = bb >= 0 ? Vec6(data.oMi[bb].act(data.v[bb])) : Vec6::Zero();
+    for (int i = 0; i < m; ++i) {
+      double value = cd.b[o + i];
+      if (a >= 0) value += blk.Wa.row(i).dot(Va);
+      if (bb >= 0) value -= blk.Wb.row(i).dot(Vb);
+      r = std::max(r, std::abs(value));
+    }
+  }
   return r;
+}
+
+double velocityResidual(const Model& model, Data& data, const ConstraintList& constraints,
+                        const ConstraintData& cd, const VecX& q, const VecX& v) {
+  forwardKinematics(model, data, q, v);
+  return velocityResidual(data, constraints, cd, v);
 }
 
 double gapResidual(const ConstraintData& cd) {

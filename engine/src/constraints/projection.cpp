@@ -1,11 +1,10 @@
-#include <appell/appell_maggi.hpp>
 #include <appell/configuration.hpp>
 #include <appell/dynamics.hpp>
-#include <appell/kkt.hpp>
 #include <appell/projection.hpp>
 
 #include "solvers/row_basis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -15,15 +14,44 @@ namespace appell {
 struct PositionProjector::Impl {
   Impl(const Model& model, const ConstraintList& constraints, const ProjectionOptions& o)
       : opt(o), mh(countHolonomic(constraints)), llt(model.nv), basis(model.nv, mh),
-        Ah(MatX::Zero(mh, model.nv)), B(MatX::Zero(model.nv, mh)), g(VecX::Zero(mh)),
+        Ah(MatX::Zero(mh, model.nv)), B(MatX::Zero(model.nv, mh)), J(MatX::Zero(6, model.nv)),
+        g(VecX::Zero(mh)),
         y(VecX::Zero(model.nv)), theta(VecX::Zero(model.nv)), v0(VecX::Zero(model.nv)),
         q_start(VecX::Zero(model.nq)), q_next(VecX::Zero(model.nq)) {
     if (!(o.gap_tol > 0) || o.max_iterations < 1)
       throw std::invalid_argument("ProjectionOptions: gap_tol must be > 0 and max_iterations >= 1");
-    for (const auto& c : constraints)
-      for (int r = 0; r < c->rows(); ++r) holonomic_flags.push_back(c->holonomic(r));
+    int rows_max = 0;
+    for (size_t k = 0; k < constraints.size(); ++k) {
+      const Constraint& c = *constraints[k];
+      bool any = false;
+      for (int r = 0; r < c.rows(); ++r) {
+        holonomic_flags.push_back(c.holonomic(r));
+        any = any || c.holonomic(r);
+      }
+      if (any) {
+        with_gaps.push_back(static_cast<int>(k));
+        rows_max = std::max(rows_max, c.rows());
+      }
+    }
     for (int i = 0; i < static_cast<int>(holonomic_flags.size()); ++i)
       if (holonomic_flags[i]) row_map.push_back(i);
+    Ak = MatX::Zero(rows_max, model.nv);
+    abias_k = VecX::Zero(rows_max);
+  }
+
+  /// A_hol: the holonomic rows of the dense form, assembled constraint by
+  /// constraint from the rows (only the constraints that have a gap).
+  void assembleHolonomicRows(const Model& model, const Data& data,
+                             const ConstraintList& constraints, const ConstraintData& cdata) {
+    int k = 0;
+    for (int c : with_gaps) {
+      const Constraint& con = *constraints[c];
+      const int o = cdata.offset[c], m = con.rows();
+      assembleConstraintRows(model, data, con, cdata.blocks[c], J, Ak.topRows(m),
+                             abias_k.head(m));
+      for (int r = 0; r < m; ++r)
+        if (holonomic_flags[o + r]) Ah.row(k++) = Ak.row(r);
+    }
   }
 
   static int countHolonomic(const ConstraintList& constraints) {
@@ -39,10 +67,11 @@ struct PositionProjector::Impl {
   int mh;
   Eigen::LLT<MatX> llt;
   detail::RowBasis basis;
-  MatX Ah, B;
-  VecX g, y, theta, v0, q_start, q_next;
+  MatX Ah, B, J, Ak;
+  VecX g, y, theta, v0, q_start, q_next, abias_k;
   std::vector<char> holonomic_flags;
-  std::vector<int> row_map;  // holonomic row → dense row
+  std::vector<int> row_map;    // holonomic row → row of the system
+  std::vector<int> with_gaps;  // constraints with at least one holonomic row
 };
 
 PositionProjector::PositionProjector(const Model& model, const ConstraintList& constraints,
@@ -67,14 +96,14 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
   w.q_start = q;
   auto fail = [&](std::string why) {
     q = w.q_start;
-    evaluateConstraints(model, data, constraints, cdata, t, q, w.v0);
+    evaluateConstraintRows(model, data, constraints, cdata, t, q, w.v0);
     res.ok = false;
     res.error = std::move(why);
     return res;
   };
   double prev = std::numeric_limits<double>::infinity();
   for (int it = 0;; ++it) {
-    evaluateConstraints(model, data, constraints, cdata, t, q, w.v0);
+    evaluateConstraintRows(model, data, constraints, cdata, t, q, w.v0);
     if (cdata.singular) return fail("singular contact geometry: " + cdata.singular_reason);
     for (int k = 0; k < w.mh; ++k) w.g[k] = cdata.gap[w.row_map[k]];
     const double gmax = w.mh ? w.g.lpNorm<Eigen::Infinity>() : 0.0;
@@ -93,9 +122,9 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
     }
     prev = gmax;
     // Least-M-norm Newton step: A_hol δ = −g,  δ = L⁻ᵀ y,  (A_hol L⁻ᵀ) y = −g.
+    w.assembleHolonomicRows(model, data, constraints, cdata);  // before crba reuses data
     w.llt.compute(crba(model, data, q));
     if (w.llt.info() != Eigen::Success) return fail("mass matrix is not positive definite");
-    for (int k = 0; k < w.mh; ++k) w.Ah.row(k) = cdata.A.row(w.row_map[k]);
     w.B = w.Ah.transpose();
     w.llt.matrixL().solveInPlace(w.B);
     w.basis.factor(w.B, w.opt.rank, /*form_q=*/false);
@@ -119,16 +148,6 @@ PositionProjectionResult projectPositions(const Model& model, Data& data,
   return projector.project(model, data, constraints, cdata, t, q);
 }
 
-namespace {
-
-std::string solverError(const ConstrainedSolver& solver) {
-  if (auto* k = dynamic_cast<const KktSolver*>(&solver)) return k->lastError();
-  if (auto* a = dynamic_cast<const AppellSolver*>(&solver)) return a->lastError();
-  return "the constraint rows are inconsistent";
-}
-
-}  // namespace
-
 StateProjectionResult projectState(const Model& model, Data& data,
                                    const ConstraintList& constraints, ConstraintData& cdata,
                                    ConstrainedSolver& solver, PositionProjector& projector,
@@ -140,21 +159,41 @@ StateProjectionResult projectState(const Model& model, Data& data,
     res.error = res.position.error;
     return res;
   }
-  // cdata now holds A(q, t), b(q, t) at the projected q.
+  // cdata now holds the rows at the projected q.
   if (!solver.projectVelocity(model, data, constraints, cdata, q, v, impulse)) {
     res.ok = false;
-    res.error = "velocity projection failed: " + solverError(solver);
+    res.error = "velocity projection failed: " + solver.lastError();
     return res;
   }
-  res.velocity_residual = velocityResidual(cdata, v);
+  res.velocity_residual = velocityResidual(model, data, constraints, cdata, q, v);
   res.gap_residual = gapResidual(cdata);
   return res;
 }
 
-void applyBaumgarte(ConstraintData& cdata, const VecX& v, double alpha, double beta) {
-  if (cdata.m == 0) return;
-  cdata.abias.noalias() += (2.0 * alpha) * (cdata.A * v);
-  cdata.abias += (2.0 * alpha) * cdata.b + (beta * beta) * cdata.gap;
+void applyBaumgarte(const Data& data, const ConstraintList& constraints, ConstraintData& cdata,
+                    const VecX& v, double alpha, double beta) {
+  // On the rows: κ (or Ȧv + ḃ of a joint-space row) gains 2α·(row value) + β²·gap;
+  // the dense abias = κ + W J̇v, assembled from κ, inherits it.
+  for (size_t k = 0; k < constraints.size(); ++k) {
+    const Constraint& c = *constraints[k];
+    RowBlock& blk = cdata.blocks[k];
+    const int o = cdata.offset[k], m = c.rows();
+    const int a = c.bodyA(), bb = c.bodyB();
+    Vec6 Va = Vec6::Zero(), Vb = Vec6::Zero();
+    if (!c.jointSpace()) {
+      if (a >= 0) Va = data.oMi[a].act(data.v[a]);
+      if (bb >= 0) Vb = data.oMi[bb].act(data.v[bb]);
+    }
+    for (int r = 0; r < m; ++r) {
+      double value = cdata.b[o + r];
+      if (c.jointSpace()) value += blk.A_joint.row(r).dot(v);
+      else value += blk.Wa.row(r).dot(Va) - (bb >= 0 ? blk.Wb.row(r).dot(Vb) : 0.0);
+      const double add = 2.0 * alpha * value + beta * beta * cdata.gap[o + r];
+      if (c.jointSpace()) blk.abias_joint[r] += add;
+      else blk.kappa[r] += add;
+      if (cdata.has_dense) cdata.abias[o + r] += add;
+    }
+  }
 }
 
 }  // namespace appell

@@ -1,7 +1,5 @@
-#include <appell/appell_maggi.hpp>
 #include <appell/configuration.hpp>
 #include <appell/dynamics.hpp>
-#include <appell/kkt.hpp>
 #include <appell/simulator.hpp>
 
 #include <cmath>
@@ -27,9 +25,10 @@ class Simulator::Field final : public AccelerationField {
         return false;
       }
     }
-    evaluateConstraints(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
+    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
     if (s.options_.baumgarte.enabled)
-      applyBaumgarte(*s.cdata_, v, s.options_.baumgarte.alpha, s.options_.baumgarte.beta);
+      applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
+                     s.options_.baumgarte.beta);
     s.solver_->solve(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, tau_, stage_);
     if (!stage_.ok) {
       record(stage_.error, t);
@@ -75,7 +74,9 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   for (const auto& c : constraints_)
     if (!c) throw std::invalid_argument("Simulator: the constraint list holds a null constraint");
   data_ = std::make_unique<Data>(model_);
-  cdata_ = std::make_unique<ConstraintData>(model_, constraints_);
+  // Dense storage (m × nv) only for the formulations that assemble A.
+  cdata_ = std::make_unique<ConstraintData>(
+      model_, constraints_, solver_->usesDenseRows() ? DenseRows::Sized : DenseRows::None);
   projector_ = std::make_unique<PositionProjector>(model_, constraints_, options_.projection);
   field_ = std::make_unique<Field>(*this);
   q_ = neutralConfiguration(model_);
@@ -84,7 +85,6 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   v_prev_ = v_;
   tau_ = VecX::Zero(model_.nv);
   impulse_ = VecX::Zero(cdata_->m);
-  row_buf_ = VecX::Zero(cdata_->m);
   result_.vdot = VecX::Zero(model_.nv);
   result_.lambda = VecX::Zero(cdata_->m);
   result_.reaction = VecX::Zero(model_.nv);
@@ -116,10 +116,7 @@ void Simulator::setState(double t, const VecX& q, const VecX& v) {
 
 void Simulator::setJointForces(JointForces tau) { tau_fn_ = std::move(tau); }
 
-int Simulator::partitionChanges() const {
-  if (auto* a = dynamic_cast<const AppellSolver*>(solver_.get())) return a->partitionChanges();
-  return 0;
-}
+int Simulator::partitionChanges() const { return solver_->partitionChanges(); }
 
 const ContactFrame& Simulator::contactFrame(int constraint) const {
   if (constraint < 0 || constraint >= static_cast<int>(cdata_->blocks.size()))
@@ -148,15 +145,8 @@ StepStatus Simulator::fail(StepStatus st, std::string message) {
 // Reports of the current state: constraint rows, residuals, energy and, when
 // asked, the dynamics (λ, contact forces) at (t, q, v).
 bool Simulator::evaluateEndState(std::string& error) {
-  evaluateConstraints(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  // ‖A v + b‖∞ into a preallocated buffer (appell::velocityResidual makes a temporary).
-  if (cdata_->m > 0) {
-    row_buf_.noalias() = cdata_->A * v_;
-    row_buf_ += cdata_->b;
-    velocity_residual_ = row_buf_.lpNorm<Eigen::Infinity>();
-  } else {
-    velocity_residual_ = 0;
-  }
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  velocity_residual_ = appell::velocityResidual(*data_, constraints_, *cdata_, v_);
   gap_residual_ = appell::gapResidual(*cdata_);
   bool ok = true;
   if (options_.evaluate_end_state) {
@@ -230,13 +220,9 @@ StepStatus Simulator::step(double h) {
   }
   if (options_.project_velocities && cdata_->m > 0) {
     if (!options_.project_positions)
-      evaluateConstraints(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
-      std::string why = "velocity projection failed";
-      if (auto* k = dynamic_cast<const KktSolver*>(solver_.get())) why += ": " + k->lastError();
-      if (auto* a = dynamic_cast<const AppellSolver*>(solver_.get())) why += ": " + a->lastError();
-      return fail(st, why);
-    }
+      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_))
+      return fail(st, "velocity projection failed: " + solver_->lastError());
   }
   if (options_.project_positions || options_.project_velocities) integrator_->reset();
 

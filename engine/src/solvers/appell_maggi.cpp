@@ -191,11 +191,14 @@ void AppellSolver::solve(const Model& model, Data& data, const ConstraintList& c
   Impl& w = *impl_;
   detail::checkSizes("AppellSolver::solve", model, w.m, cdata, q, v, &tau);
   detail::sizeResult(model.nv, w.m, out);
+  last_error_.clear();
   if (cdata.singular) {
     out.ok = false;
     out.error = "singular contact geometry: " + cdata.singular_reason;
+    last_error_ = out.error;
     return;
   }
+  detail::assembleDense(model, data, constraints, cdata, q, v);
   const MatX& M = crba(model, data, q);
   const VecX& h = nonLinearEffects(model, data, q, v);
   w.fbuf = tau - h;
@@ -204,6 +207,7 @@ void AppellSolver::solve(const Model& model, Data& data, const ConstraintList& c
   if (!err.empty()) {
     out.ok = false;
     out.error = std::move(err);
+    last_error_ = out.error;
     return;
   }
   out.rank = w.basis.rank();
@@ -219,11 +223,13 @@ bool AppellSolver::projectVelocity(const Model& model, Data& data,
   detail::checkSizes("AppellSolver::projectVelocity", model, w.m, cdata, q, v, nullptr);
   impulse.resize(w.m);
   impulse.setZero();
+  last_error_.clear();
   if (w.m == 0) return true;
   if (cdata.singular) {
     last_error_ = "singular contact geometry: " + cdata.singular_reason;
     return false;
   }
+  detail::assembleDense(model, data, constraints, cdata, q, v);
   const MatX& M = crba(model, data, q);
   // min ½‖v⁺ − v‖²_M subject to A v⁺ = −b: the Maggi equations with f = M v.
   w.fbuf.noalias() = M * v;

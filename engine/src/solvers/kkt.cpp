@@ -1,4 +1,5 @@
 #include <appell/dynamics.hpp>
+#include <appell/kinematics.hpp>
 #include <appell/kkt.hpp>
 
 #include "solvers/row_basis.hpp"
@@ -33,6 +34,14 @@ void checkSizes(const char* who, const Model& model, int m, const ConstraintData
   if (tau && tau->size() != model.nv)
     fail("tau has size " + std::to_string(tau->size()) + ", expected nv = " +
          std::to_string(model.nv));
+}
+
+void assembleDense(const Model& model, Data& data, const ConstraintList& constraints,
+                   ConstraintData& cdata, const VecX& q, const VecX& v) {
+  // J̇v at (q, v) for abias; the rows themselves were evaluated by the caller.
+  data.ddq.setZero();
+  forwardKinematics(model, data, q, v, data.ddq);
+  assembleDenseRows(model, data, constraints, cdata);
 }
 
 void sizeResult(int nv, int m, ConstrainedResult& out) {
@@ -83,18 +92,17 @@ void KktSolver::solve(const Model& model, Data& data, const ConstraintList& cons
   const int m = w.basis.m();
   detail::checkSizes("KktSolver::solve", model, m, cdata, q, v, &tau);
   detail::sizeResult(model.nv, m, out);
-  if (cdata.singular) {
+  last_error_.clear();
+  auto fail = [&](std::string why) {
     out.ok = false;
-    out.error = "singular contact geometry: " + cdata.singular_reason;
-    return;
-  }
+    out.error = std::move(why);
+    last_error_ = out.error;
+  };
+  if (cdata.singular) return fail("singular contact geometry: " + cdata.singular_reason);
+  detail::assembleDense(model, data, constraints, cdata, q, v);
   const MatX& M = crba(model, data, q);
   const VecX& h = nonLinearEffects(model, data, q, v);
-  if (!w.factorMass(M)) {
-    out.ok = false;
-    out.error = "mass matrix is not positive definite";
-    return;
-  }
+  if (!w.factorMass(M)) return fail("mass matrix is not positive definite");
   // Unconstrained acceleration a = M⁻¹(τ − h).
   w.a = tau - h;
   w.llt.solveInPlace(w.a);
@@ -109,11 +117,7 @@ void KktSolver::solve(const Model& model, Data& data, const ConstraintList& cons
   // Constraint defect of the free motion: d = c − A a, c = −abias.
   w.d.noalias() = -cdata.A * w.a;
   w.d -= cdata.abias;
-  if (!w.basis.solveRows(w.d, w.y)) {
-    out.ok = false;
-    out.error = w.basis.describeInconsistency(constraints, cdata);
-    return;
-  }
+  if (!w.basis.solveRows(w.d, w.y)) return fail(w.basis.describeInconsistency(constraints, cdata));
   // v̇ = a + L⁻ᵀ y;  Aᵀλ = M(v̇ − a) = L y  ⇔  L⁻¹Aᵀλ = y.
   out.vdot = w.y;
   w.llt.matrixU().solveInPlace(out.vdot);
@@ -129,11 +133,13 @@ bool KktSolver::projectVelocity(const Model& model, Data& data, const Constraint
   detail::checkSizes("KktSolver::projectVelocity", model, m, cdata, q, v, nullptr);
   impulse.resize(m);
   impulse.setZero();
+  last_error_.clear();
   if (m == 0) return true;
   if (cdata.singular) {
     last_error_ = "singular contact geometry: " + cdata.singular_reason;
     return false;
   }
+  detail::assembleDense(model, data, constraints, cdata, q, v);
   if (!w.factorMass(crba(model, data, q))) {
     last_error_ = "mass matrix is not positive definite";
     return false;

@@ -107,6 +107,10 @@ int totalRows(const ConstraintList& constraints);
 /// Throws std::invalid_argument naming `who` when sizes do not match the system.
 void checkSizes(const char* who, const Model& model, int m, const ConstraintData& cdata,
                 const VecX& q, const VecX& v, const VecX* tau);
+/// The dense form A, abias of the rows in `cdata` (evaluated at q, v): a dense
+/// solver's first step. Overwrites `data` with forwardKinematics(q, v, 0).
+void assembleDense(const Model& model, Data& data, const ConstraintList& constraints,
+                   ConstraintData& cdata, const VecX& q, const VecX& v);
 /// Sizes the result (no allocation once sized) and clears its status.
 void sizeResult(int nv, int m, ConstrainedResult& out);
 

@@ -135,9 +135,11 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   if (out.reaction.size() != model.nv) out.reaction.resize(model.nv);
   out.ok = true;
   out.error.clear();
+  ws.last_error.clear();
   if (cdata.singular) {
     out.ok = false;
     out.error = "singular constraint geometry: " + cdata.singular_reason;
+    ws.last_error = out.error;
     return;
   }
 
@@ -161,6 +163,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
       !detail::solveLoops(model, data, cdata, ws)) {
     out.ok = false;
     out.error = detail::describeFailure(model, data, ws);
+    ws.last_error = out.error;
     return;
   }
   ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;

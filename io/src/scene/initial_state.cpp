@@ -63,7 +63,7 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
   ConstraintData cd(model, scene.constraints);
   evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
   if (cd.singular) singular(scene, cd);
-  report.velocity_residual = velocityResidual(cd, scene.v0);
+  report.velocity_residual = velocityResidual(data, scene.constraints, cd, scene.v0);
   report.gap_residual = gapResidual(cd);
   notFinite(scene, report);
   if (report.velocity_residual <= tol && report.gap_residual <= tol) return report;
@@ -109,7 +109,7 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
   }
   evaluateConstraints(model, data, scene.constraints, cd, 0.0, q, v);
   if (cd.singular) singular(scene, cd);
-  report.velocity_residual = velocityResidual(cd, v);
+  report.velocity_residual = velocityResidual(data, scene.constraints, cd, v);
   report.gap_residual = gapResidual(cd);
   notFinite(scene, report);
   if (report.velocity_residual > tol || report.gap_residual > tol) {
