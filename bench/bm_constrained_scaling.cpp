@@ -5,7 +5,10 @@
 // BM_TreeOverAba interleaves one tree solve and one aba() on the same state in
 // every iteration and reports the ratio of their summed times: both see the
 // same machine state (clock, neighbours, caches), so the ratio stays stable
-// when the absolute times of separate runs drift.
+// when the absolute times of separate runs drift. It times the solve an
+// integrator stage makes (SolveOutputs::Accelerations: v̇, as ABA gives);
+// BM_TreeLambdaOverAba the same with the minimum-norm λ and Aᵀλ (what a report
+// or a step's end state asks for).
 // BM_TreeLoops: the cost of k loop-closing rows over the same tree solve.
 // The dense solvers stop at 256 bodies (O(n³); the comparison point is 256).
 // Each iteration evaluates nothing: the rows are evaluated once at a state
@@ -38,7 +41,7 @@ scenes::ScalingScene makeScene(int kind, int bodies) {
   }
 }
 
-enum class Which { Tree, Aba, Kkt, Appell, TreeOverAba };
+enum class Which { Tree, Aba, Kkt, Appell, TreeOverAba, TreeLambdaOverAba };
 
 void run(benchmark::State& st, Which which) {
   auto s = makeScene(static_cast<int>(st.range(0)), static_cast<int>(st.range(1)));
@@ -48,7 +51,8 @@ void run(benchmark::State& st, Which which) {
   switch (which) {
     case Which::Tree:
     case Which::Aba:
-    case Which::TreeOverAba: solver = makeTreeSolver(s.model, s.constraints); break;
+    case Which::TreeOverAba:
+    case Which::TreeLambdaOverAba: solver = makeTreeSolver(s.model, s.constraints); break;
     case Which::Kkt: solver = std::make_unique<KktSolver>(s.model, s.constraints); break;
     case Which::Appell: solver = std::make_unique<AppellSolver>(s.model, s.constraints); break;
   }
@@ -63,12 +67,14 @@ void run(benchmark::State& st, Which which) {
   ConstrainedResult out;
   if (which == Which::Aba) {
     for (auto _ : st) benchmark::DoNotOptimize(aba(s.model, data, s.q, v, tau).data());
-  } else if (which == Which::TreeOverAba) {
+  } else if (which == Which::TreeOverAba || which == Which::TreeLambdaOverAba) {
+    const SolveOutputs outputs =
+        which == Which::TreeOverAba ? SolveOutputs::Accelerations : SolveOutputs::All;
     using Clock = std::chrono::steady_clock;
     double tree_s = 0, aba_s = 0;
     for (auto _ : st) {
       const auto t0 = Clock::now();
-      solver->solve(s.model, data, s.constraints, cd, s.q, v, tau, out);
+      solver->solve(s.model, data, s.constraints, cd, s.q, v, tau, out, outputs);
       benchmark::DoNotOptimize(out.vdot.data());
       const auto t1 = Clock::now();
       benchmark::DoNotOptimize(aba(s.model, data, s.q, v, tau).data());
@@ -107,6 +113,7 @@ void BM_Aba(benchmark::State& st) { run(st, Which::Aba); }
 void BM_Kkt(benchmark::State& st) { run(st, Which::Kkt); }
 void BM_Appell(benchmark::State& st) { run(st, Which::Appell); }
 void BM_TreeOverAba(benchmark::State& st) { run(st, Which::TreeOverAba); }
+void BM_TreeLambdaOverAba(benchmark::State& st) { run(st, Which::TreeLambdaOverAba); }
 
 /// Loop rows: the fleet (N bodies) with the left wheels of robots 0 … k
 /// geared together (joint-space rows q̇_L(r) − q̇_L(r+1) = 0, an electronic
@@ -182,6 +189,7 @@ BENCHMARK(BM_Aba)->Apply([](auto* b) { sizes(b, 1024); });
 BENCHMARK(BM_Kkt)->Apply([](auto* b) { sizes(b, 256); });
 BENCHMARK(BM_Appell)->Apply([](auto* b) { sizes(b, 256); });
 BENCHMARK(BM_TreeOverAba)->Apply([](auto* b) { sizes(b, 1024); });
+BENCHMARK(BM_TreeLambdaOverAba)->Apply([](auto* b) { sizes(b, 1024); });
 BENCHMARK(BM_TreeLoops)
     ->ArgsProduct({{64, 256, 1024}, {1, 4, 16}})
     ->ArgNames({"N", "k"})

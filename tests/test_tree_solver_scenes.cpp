@@ -51,6 +51,14 @@ void checkScene(scenes::ScalingScene s) {
   ASSERT_TRUE(ko.ok) << ko.error;
   EXPECT_LT(relErr(out.lambda, ko.lambda), 1e-10);
   EXPECT_EQ(out.redundant, ko.redundant);
+  // An integrator stage asks for v̇ alone: the same v̇ to the bit and the same
+  // rank, without the minimum-norm sweep.
+  ConstrainedResult stage;
+  solver.solve(s.model, data, s.constraints, cd, s.q, v, tau, stage, SolveOutputs::Accelerations);
+  ASSERT_TRUE(stage.ok) << stage.error;
+  EXPECT_EQ(stage.vdot, out.vdot);
+  EXPECT_EQ(stage.rank, out.rank);
+  EXPECT_EQ(stage.redundant, out.redundant);
 }
 
 }  // namespace

@@ -56,7 +56,8 @@ class AppellSolver final : public ConstrainedSolver {
   bool usesDenseRows() const override { return true; }
   void solve(const Model& model, Data& data, const ConstraintList& constraints,
              ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
-             ConstrainedResult& out) override;
+             ConstrainedResult& out,
+             SolveOutputs outputs = SolveOutputs::All) override;
   /// v⁺ = N e + η₀ minimising ‖v⁺ − v‖_M (NᵀM(v⁺ − v) = 0), with the impulse
   /// μ (minimum norm) such that v⁺ = v − M⁻¹Aᵀμ.
   bool projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,

@@ -41,6 +41,14 @@ struct SolverOptions {
   double consistency_tol = 1e-8; ///< residual above which redundant rows are inconsistent
 };
 
+/// What a solve must produce. Integrator stages need only v̇; reports need λ.
+/// The minimum-norm λ costs the tree solver an extra sweep when rows are
+/// redundant across bodies (docs/tree-solver.md), so stages skip it.
+enum class SolveOutputs {
+  All,            ///< v̇, the minimum-norm λ, Aᵀλ, rank
+  Accelerations,  ///< v̇ and rank only; λ and Aᵀλ are left unspecified
+};
+
 struct ConstrainedResult {
   VecX vdot;                 ///< nv
   VecX lambda;               ///< m, one multiplier per row (minimum norm: see above)
@@ -62,9 +70,10 @@ class ConstrainedSolver {
   /// Accelerations and reactions at (t, q, v) under joint forces τ (gravity from
   /// the model). `cdata` must hold the rows at (t, q, v) (evaluateConstraintRows;
   /// a dense solver assembles A and abias itself); `data` is workspace.
+  /// `outputs`: everything, or v̇ alone (what an integrator stage needs).
   virtual void solve(const Model& model, Data& data, const ConstraintList& constraints,
                      ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
-                     ConstrainedResult& out) = 0;
+                     ConstrainedResult& out, SolveOutputs outputs = SolveOutputs::All) = 0;
   /// Impulse solve for drift control: v ← argmin ‖v⁺ − v‖_M subject to A v⁺ + b = 0,
   /// with the rows in `cdata` evaluated at q. Writes the impulses (m) to `impulse`.
   /// Returns false (v untouched, lastError() says why) when the rows are inconsistent.

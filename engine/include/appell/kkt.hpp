@@ -36,7 +36,8 @@ class KktSolver final : public ConstrainedSolver {
   bool usesDenseRows() const override { return true; }
   void solve(const Model& model, Data& data, const ConstraintList& constraints,
              ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
-             ConstrainedResult& out) override;
+             ConstrainedResult& out,
+             SolveOutputs outputs = SolveOutputs::All) override;
   /// v⁺ = v − M⁻¹Aᵀμ with A v⁺ + b = 0, μ (`impulse`) of minimum norm: the
   /// M-orthogonal projection of v onto the constraint set.
   bool projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,

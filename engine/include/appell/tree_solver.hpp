@@ -53,7 +53,8 @@ class TreeSolver : public ConstrainedSolver {
 
   void solve(const Model& model, Data& data, const ConstraintList& constraints,
              ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
-             ConstrainedResult& out) override;
+             ConstrainedResult& out,
+             SolveOutputs outputs = SolveOutputs::All) override;
 
   /// v⁺ = v − M⁻¹Aᵀμ with A v⁺ + b = 0 (the M-orthogonal projection), the
   /// same recursion with no forces, no velocity products and the velocity

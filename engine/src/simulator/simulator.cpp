@@ -29,7 +29,8 @@ class Simulator::Field final : public AccelerationField {
     if (s.options_.baumgarte.enabled)
       applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
                      s.options_.baumgarte.beta);
-    s.solver_->solve(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, tau_, stage_);
+    s.solver_->solve(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, tau_, stage_,
+                     SolveOutputs::Accelerations);
     if (!stage_.ok) {
       record(stage_.error, t);
       return false;

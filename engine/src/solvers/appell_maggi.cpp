@@ -187,7 +187,9 @@ AppellSolver::~AppellSolver() = default;
 
 void AppellSolver::solve(const Model& model, Data& data, const ConstraintList& constraints,
                          ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
-                         ConstrainedResult& out) {
+                         ConstrainedResult& out,
+                         SolveOutputs outputs) {
+  (void)outputs;  // a dense reference always writes λ and Aᵀλ (they cost little next to its O(n³) factorisation)
   Impl& w = *impl_;
   detail::checkSizes("AppellSolver::solve", model, w.m, cdata, q, v, &tau);
   detail::sizeResult(model.nv, w.m, out);

@@ -87,7 +87,9 @@ KktSolver::~KktSolver() = default;
 
 void KktSolver::solve(const Model& model, Data& data, const ConstraintList& constraints,
                       ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
-                      ConstrainedResult& out) {
+                      ConstrainedResult& out,
+                      SolveOutputs outputs) {
+  (void)outputs;  // a dense reference always writes λ and Aᵀλ (they cost little next to its O(n³) factorisation)
   Impl& w = *impl_;
   const int m = w.basis.m();
   detail::checkSizes("KktSolver::solve", model, m, cdata, q, v, &tau);

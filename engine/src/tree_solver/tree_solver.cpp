@@ -126,7 +126,8 @@ void velocityTerms(const Model& model, const Data& data, const VecX& v, detail::
 
 void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& constraints,
                        ConstraintData& cdata, const VecX& q, const VecX& v, const VecX& tau,
-                       ConstrainedResult& out) {
+                       ConstrainedResult& out,
+                       SolveOutputs outputs) {
   (void)constraints;
   auto& ws = *ws_;
   checkSizes(model, cdata, ws);
@@ -167,12 +168,13 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     return;
   }
   ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;
-  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);
   out.vdot = ws.vdot;
-  out.lambda = ws.lambda;
-  detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
   out.redundant = ws.redundant;
   out.rank = ws.m - ws.redundant;
+  if (outputs == SolveOutputs::Accelerations) return;  // an integrator stage: v̇ is all it reads
+  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);
+  out.lambda = ws.lambda;
+  detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
 }
 
 bool TreeSolver::projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,
