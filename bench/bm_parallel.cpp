@@ -1,7 +1,7 @@
 // Throughput of many independent simulations on 1 and 2 threads.
 //
 // A Model is immutable and shared; each simulation owns its Data, workspace and
-// state (DESIGN.md §4), so independent scenes step in parallel with no locks.
+// state (docs/architecture.md: an immutable Model, all mutable data in Data), so independent scenes step in parallel with no locks.
 // Each benchmark steps 64 rolling disks by 50 RK4 steps each, split over the
 // threads; items/s counts simulation steps. The scaling is the ratio of the
 // two items/s figures measured in the same run.

@@ -1,8 +1,8 @@
 // Linearization about steady motions of a rolling disk (relative equilibria),
 // with position, heading and spin as cyclic coordinates (rollingDiskChain).
 //
-// Straight rolling of an upright disk at axle rate s: REFERENCES.md's lean-frame
-// equations linearised at θ = 0, u₁ = 0, u₂ = s, u₃ = 0 give
+// Straight rolling of an upright disk at axle rate s: the lean-frame equations of
+// Kane & Levinson (Dynamics: Theory and Applications, 1985, the rolling disk), linearised at θ = 0, u₁ = 0, u₂ = s, u₃ = 0 give
 //   θ̇ = u₁,  u̇₁ = (6 s r u₃ + 4 g θ)/(5 r),  u̇₂ = 0,  u̇₃ = −2 s u₁,
 // whose eigenvalues are 0, 0, ±√(4g/(5r) − 12 s²/5): stable (imaginary) iff
 // s² > g/(3r). The two zeros are the neighbouring steady motions (another

@@ -27,7 +27,7 @@ Vec3 contactForce(const VecX& lambda, const ContactFrame& f) {
 
 }  // namespace
 
-// REFERENCES.md: x = ρ(sin φ − sin φ₀) + x₀, y = −ρ(cos φ − cos φ₀) + y₀,
+// The vertical rolling disk (Bloch, Nonholonomic Mechanics and Control, 2003): x = ρ(sin φ − sin φ₀) + x₀, y = −ρ(cos φ − cos φ₀) + y₀,
 // ρ = ω_θ R/ω_φ, φ = ω_φ t + φ₀; the contact force is m ω_φ R ω_θ (−sin φ, cos φ)
 // (the centripetal force of the centre's uniform circular motion).
 TEST(VerticalRollingDisk, CentreFollowsTheExactCircleAndMultipliersMatch) {

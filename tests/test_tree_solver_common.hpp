@@ -1,6 +1,6 @@
 // Shared pieces of the tree-solver tests: test-only constraints with random
 // body-local rows, consistent right sides, and the dense Udwadia–Kalaba
-// reference (REFERENCES.md):
+// reference (Udwadia & Kalaba, Proc. R. Soc. Lond. A 439, 1992):
 //   v̇ = a + M^{-½}(A M^{-½})⁺(c − A a),  a = M⁻¹(τ − h),  c = −abias,
 //   λ_min = (Aᵀ)⁺(M v̇ + h − τ).
 #pragma once

@@ -1,6 +1,6 @@
 // Constrained forward dynamics: the interface every formulation implements.
 //
-//   M v̇ + h = τ + Aᵀλ,      A v̇ + abias = 0          (DESIGN.md §1)
+//   M v̇ + h = τ + Aᵀλ,      A v̇ + abias = 0          (Neimark & Fufaev 1967)
 //
 // Three formulations give the same v̇ and the same reaction Aᵀλ:
 //   Multipliers  dense KKT (reference)                       kkt.hpp

@@ -1,7 +1,7 @@
 // Dense multiplier (KKT) formulation — a reference solver, kept forever.
 //
 //   [ M  Aᵀ ] [ v̇ ]   [ τ − h  ]
-//   [ A  0  ] [ −λ ] = [ −abias ]                        (DESIGN.md §1)
+//   [ A  0  ] [ −λ ] = [ −abias ]                        (docs/solvers.md)
 //
 // solved by the range-space method in the mass metric, which stays exact with
 // redundant rows: M = LLᵀ (Cholesky), a = M⁻¹(τ − h), and a column-pivoted

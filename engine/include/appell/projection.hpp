@@ -1,7 +1,7 @@
 // Drift control: keep the state on the constraint manifold.
 //
 // An integrator keeps A v + b = 0 and g(q, t) = 0 only up to its truncation
-// error. After every step (DESIGN.md §1, "Drift"):
+// error. After every step (docs/solvers.md, "Drift control"):
 //  1. positions — Newton on the holonomic gaps g(q, t) = 0 (rows flagged
 //     holonomic, gaps from ConstraintData::gap; A_hol assembled from those rows
 //     only, A_hol = Wₐ Jₐ − W_b J_b). Each iteration takes the

@@ -1,5 +1,5 @@
 // The O(n + m) constrained-dynamics kernel: Gauss' principle solved exactly by
-// dynamic programming on the kinematic tree (DESIGN.md §2, docs/tree-solver.md).
+// dynamic programming on the kinematic tree (Gauss 1829; Vereshchagin 1974; Sathya, Bruyninckx, Decré and Pipeleers, IEEE T-RO 2024 — docs/tree-solver.md).
 //
 //   minimise ½ v̇ᵀ M v̇ + v̇ᵀ(h − τ)   subject to  A v̇ + abias = 0
 //
