@@ -3,6 +3,8 @@
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
 
+#include "run_command.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,21 +18,8 @@ namespace {
 const std::string kAppell = std::string(APPELL_BINARY_DIR) + "/cli/appell";
 const std::string kDisk = std::string(APPELL_SOURCE_DIR) + "/examples/rolling_disk/rolling_disk.urdf";
 
-struct Result {
-  int status;
-  std::string output;
-};
-
-Result sh(const std::string& args) {
-  Result r{-1, ""};
-  FILE* p = popen((kAppell + " " + args + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, p)) r.output.append(buf, n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+using Result = appell::test::CommandResult;
+Result sh(const std::string& args) { return appell::test::runAppell(args); }
 
 double field(const std::string& text, const std::string& pattern) {
   std::smatch m;

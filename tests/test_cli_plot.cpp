@@ -5,6 +5,8 @@
 // (tests/viewer/test_viewer.mjs).
 #include <appell/trajectory_reader.hpp>
 
+#include "run_command.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -25,21 +27,8 @@ const std::string kDisk = std::string(APPELL_SOURCE_DIR) + "/examples/rolling_di
 // One folder per process: ctest runs each test of this file as its own process, in parallel.
 const fs::path kWork = fs::path(APPELL_BINARY_DIR) / ("test_cli_plot_" + std::to_string(getpid()));
 
-struct Result {
-  int status;
-  std::string output;
-};
-
-Result sh(const std::string& args) {
-  Result r{-1, ""};
-  FILE* p = popen((kAppell + " " + args + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, p)) r.output.append(buf, n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+using Result = appell::test::CommandResult;
+Result sh(const std::string& args) { return appell::test::runAppell(args); }
 
 std::string slurp(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

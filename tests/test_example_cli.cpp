@@ -5,6 +5,8 @@
 // and the example programs built in the same build tree.
 #include <appell/urdf.hpp>
 
+#include "run_command.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -28,22 +30,8 @@ const std::string kBinary = APPELL_BINARY_DIR;
 
 std::string example(const std::string& rel) { return kSource + "/examples/" + rel; }
 
-struct Output {
-  int status = -1;
-  std::string text;  ///< stdout and stderr
-};
-
-Output runCommand(const std::string& cmd) {
-  Output out;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return out;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.text.append(buf.data(), n);
-  const int st = pclose(p);
-  out.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return out;
-}
+using Output = appell::test::CommandResult;
+using appell::test::runCommand;
 
 std::string program(const std::string& rel) {
   const std::string path = kBinary + "/" + rel;
@@ -95,20 +83,20 @@ TEST_P(ExampleRun, RunsWithTheExpectedSummary) {
   const RunCase c = GetParam();
   const Output o = runCommand(program("cli/appell") + " run " + example(c.file) +
                               " --duration 1 --quiet");
-  ASSERT_EQ(o.status, 0) << o.text;
-  EXPECT_LT(number(o.text, R"(max \|Av\+b\| = ([0-9.eE+-]+))"), 1e-10) << o.text;
-  EXPECT_LT(number(o.text, R"(max \|gap\| = ([0-9.eE+-]+))"), 1e-10) << o.text;
-  EXPECT_EQ(number(o.text, R"(redundant\s+([0-9]+) rows)"), c.redundant) << o.text;
-  EXPECT_NE(o.text.find("events       none"), std::string::npos) << o.text;
-  EXPECT_EQ(o.text.find("would lift off"), std::string::npos) << o.text;
+  ASSERT_EQ(o.status, 0) << o.output;
+  EXPECT_LT(number(o.output, R"(max \|Av\+b\| = ([0-9.eE+-]+))"), 1e-10) << o.output;
+  EXPECT_LT(number(o.output, R"(max \|gap\| = ([0-9.eE+-]+))"), 1e-10) << o.output;
+  EXPECT_EQ(number(o.output, R"(redundant\s+([0-9]+) rows)"), c.redundant) << o.output;
+  EXPECT_NE(o.output.find("events       none"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("would lift off"), std::string::npos) << o.output;
   if (c.passive)
-    EXPECT_LT(number(o.text, R"(\(([0-9.eE+-]+) relative\))"), 1e-8) << o.text;
+    EXPECT_LT(number(o.output, R"(\(([0-9.eE+-]+) relative\))"), 1e-8) << o.output;
   else
-    EXPECT_NE(o.text.find("energy is not conserved"), std::string::npos) << o.text;
+    EXPECT_NE(o.output.find("energy is not conserved"), std::string::npos) << o.output;
   // info: the same rows and redundancy at the initial state.
   const Output info = runCommand(program("cli/appell") + " info " + example(c.file));
-  ASSERT_EQ(info.status, 0) << info.text;
-  EXPECT_EQ(number(info.text, R"(\(([0-9]+) redundant\))"), c.redundant) << info.text;
+  ASSERT_EQ(info.status, 0) << info.output;
+  EXPECT_EQ(number(info.output, R"(\(([0-9]+) redundant\))"), c.redundant) << info.output;
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -130,9 +118,9 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(ExampleCli, CarInfoReportsRankAndRedundancy) {
   const Output o = runCommand(program("cli/appell") + " info " + example("car/car.urdf"));
-  ASSERT_EQ(o.status, 0) << o.text;
-  EXPECT_NE(o.text.find("rank 9 of 12 rows (3 redundant)"), std::string::npos) << o.text;
-  EXPECT_NE(o.text.find("1 independent velocities"), std::string::npos) << o.text;
+  ASSERT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("rank 9 of 12 rows (3 redundant)"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("1 independent velocities"), std::string::npos) << o.output;
 }
 
 TEST(ExampleCli, CarRunWritesLoadsOnAllFourWheels) {
@@ -140,11 +128,11 @@ TEST(ExampleCli, CarRunWritesLoadsOnAllFourWheels) {
   const std::string csv = dir / "car.csv";
   const Output o = runCommand(program("cli/appell") + " run " + example("car/car.urdf") +
                               " --duration 0.5 --quiet --out " + csv);
-  ASSERT_EQ(o.status, 0) << o.text;
+  ASSERT_EQ(o.status, 0) << o.output;
   for (const char* w : {"front_left", "front_right", "rear_left", "rear_right"}) {
     // "  front_left_tyre    normal load 71.12 … 71.12 N"
-    const double load = number(o.text, std::string(w) + R"(_tyre\s+normal load ([0-9.]+))");
-    EXPECT_NEAR(load, w[0] == 'f' ? 71.1225 : 46.5975, 0.01) << o.text;
+    const double load = number(o.output, std::string(w) + R"(_tyre\s+normal load ([0-9.]+))");
+    EXPECT_NEAR(load, w[0] == 'f' ? 71.1225 : 46.5975, 0.01) << o.output;
   }
   const std::string header = readFile(csv).substr(0, readFile(csv).find('\n'));
   EXPECT_NE(header.find("lambda:rear_right_tyre.normal"), std::string::npos) << header;
@@ -157,7 +145,7 @@ TEST(ExampleGenerators, MakeNTrailerReproducesTheCommittedFile) {
   TempDir dir;
   const std::string out = dir / "ntrailer3.urdf";
   const Output o = runCommand(program("examples/example_make_ntrailer") + " 3 " + out);
-  ASSERT_EQ(o.status, 0) << o.text;
+  ASSERT_EQ(o.status, 0) << o.output;
   EXPECT_EQ(readFile(out), readFile(example("ntrailer/ntrailer3.urdf")))
       << "examples/ntrailer/ntrailer3.urdf is stale: regenerate it (docs/examples.md)";
 }
@@ -166,21 +154,21 @@ TEST(ExampleGenerators, MakeNTrailerScalesToTenTrailers) {
   TempDir dir;
   const std::string out = dir / "ntrailer10.urdf";
   const Output o = runCommand(program("examples/example_make_ntrailer") + " 10 " + out);
-  ASSERT_EQ(o.status, 0) << o.text;
+  ASSERT_EQ(o.status, 0) << o.output;
   const Scene s = loadScene(out);
   EXPECT_EQ(s.model.nv, 6 + 2 * 10);
   EXPECT_EQ(s.constraintRows(), 4 + 2 * 10);
   const Output run = runCommand(program("cli/appell") + " run " + out + " --duration 1 --quiet");
-  ASSERT_EQ(run.status, 0) << run.text;
-  EXPECT_EQ(number(run.text, R"(redundant\s+([0-9]+) rows)"), 0) << run.text;
-  EXPECT_LT(number(run.text, R"(max \|Av\+b\| = ([0-9.eE+-]+))"), 1e-10) << run.text;
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(number(run.output, R"(redundant\s+([0-9]+) rows)"), 0) << run.output;
+  EXPECT_LT(number(run.output, R"(max \|Av\+b\| = ([0-9.eE+-]+))"), 1e-10) << run.output;
 }
 
 TEST(ExampleGenerators, MakeNTrailerRejectsBadArguments) {
   for (const char* args : {"", " 0", " -2", " 3x", " abc"}) {
     const Output o = runCommand(program("examples/example_make_ntrailer") + args);
-    EXPECT_EQ(o.status, 2) << "args '" << args << "': " << o.text;
-    EXPECT_FALSE(o.text.empty());
+    EXPECT_EQ(o.status, 2) << "args '" << args << "': " << o.output;
+    EXPECT_FALSE(o.output.empty());
   }
 }
 
@@ -188,8 +176,8 @@ TEST(ExampleGenerators, MakeMeshesReproducesTheCommittedMeshes) {
   TempDir dir;
   const std::string out = dir / "meshes";
   const Output o = runCommand(program("examples/example_make_meshes") + " " + out);
-  ASSERT_EQ(o.status, 0) << o.text;
-  EXPECT_NE(o.text.find("2176 triangles"), std::string::npos) << o.text;
+  ASSERT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("2176 triangles"), std::string::npos) << o.output;
   for (const char* f : {"wheel.stl", "wheel.dae"}) {
     const std::string made = readFile(out + "/" + f), committed = readFile(example(std::string("diff_drive/meshes/") + f));
     EXPECT_FALSE(made.empty()) << f;

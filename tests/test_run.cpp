@@ -6,6 +6,8 @@
 #include <appell/run.hpp>
 #include <appell/urdf.hpp>
 
+#include "run_command.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,16 +21,7 @@ namespace {
 
 const std::string kDisk = std::string(APPELL_SOURCE_DIR) + "/examples/rolling_disk/rolling_disk.urdf";
 
-std::string appellRun(const std::string& args) {
-  const std::string cmd = std::string(APPELL_BINARY_DIR) + "/cli/appell run " + args + " 2>&1";
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  pclose(p);
-  return out;
-}
+std::string appellRun(const std::string& args) { return test::runAppell("run " + args).output; }
 
 double field(const std::string& text, const std::string& pattern, int group = 1) {
   std::smatch m;
