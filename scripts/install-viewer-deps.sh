@@ -7,14 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-apt_install() {
-  echo "install-viewer-deps: installing $*"
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "$@" >/dev/null
-}
+apt_install() { bash scripts/apt-install.sh install-viewer-deps "$@"; }
 
 if ! command -v npm >/dev/null || ! command -v node >/dev/null; then apt_install nodejs npm; fi
 
