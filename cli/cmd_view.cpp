@@ -160,7 +160,7 @@ void appendPose(std::vector<double>& out, const SE3& X) {
 Frame frameAt(const Scene& scene, Data& data, std::vector<RowBlock>& blocks, double t,
               const VecX& q, const VecX& v, const VecX& lambda) {
   const Model& m = scene.model;
-  Frame f{t, {}, {}, {}};
+  Frame f{t, {}, {}, {}, {}};
   forwardKinematics(m, data, q, v);
   for (int b = 0; b < m.nbodies; ++b) appendPose(f.poses, data.oMi[b]);
   // A support frame moves as its motion says, or rides on its body (supports.hpp).

@@ -156,8 +156,9 @@ TEST(SimulatorFailure, ProjectionFailureReportsTheSolversReason) {
         << st.message;
     EXPECT_NE(st.message.find("twin_rows"), std::string::npos) << st.message;
     expectSameState(sim, t, q, v);
-    if (f == Formulation::Tree)  // the tree solver names where it found them
+    if (f == Formulation::Tree) {  // the tree solver names where it found them
       EXPECT_NE(st.message.find("detected at body"), std::string::npos) << st.message;
+    }
   }
 }
 

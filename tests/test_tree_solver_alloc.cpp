@@ -63,13 +63,22 @@ TEST(TreeSolverAllocations, NoneWithRowsHandedUpWithCompliance) {
   }
 }
 
-TEST(TreeSolverAllocations, NoneWithLoopRows) {
-  std::mt19937 rng(32);
-  System s = randomSystem(12, true, rng, RowRecipe{0.2, 0.2, 1});
-  Rows Ka(2, 6), Kb(2, 6);
+namespace {
+
+/// k random rows between bodies 5 and 9: a loop the tree passes cannot close.
+void addLoopRows(System& s, int k) {
+  Rows Ka(k, 6), Kb(k, 6);
   Ka.setRandom();
   Kb.setRandom();
   s.local.push_back(std::make_shared<LocalRows>("loop", 5, Ka, 9, Kb));
+}
+
+}  // namespace
+
+TEST(TreeSolverAllocations, NoneWithLoopRows) {
+  std::mt19937 rng(32);
+  System s = randomSystem(12, true, rng, RowRecipe{0.2, 0.2, 1});
+  addLoopRows(s, 2);
   s.joint.push_back(std::make_shared<JointRows>("joint", MatX::Random(1, s.model.nv)));
   makeConsistent(s, rng);
   expectNoAllocation(s);
@@ -81,10 +90,7 @@ TEST(TreeSolverAllocations, NoneWithRedundantLoopRows) {
   // that copies a tree row (the loop closure's null direction).
   std::mt19937 rng(34);
   System s = randomSystem(12, true, rng, RowRecipe{0.3, 0.3, 2});
-  Rows Ka(1, 6), Kb(1, 6);
-  Ka.setRandom();
-  Kb.setRandom();
-  s.local.push_back(std::make_shared<LocalRows>("loop", 5, Ka, 9, Kb));
+  addLoopRows(s, 1);
   addJointCopyOfLastRow(s, "copy", 2.0);
   makeConsistent(s, rng);
   const ConstrainedResult out = treeSolve(s);

@@ -11,16 +11,33 @@ using namespace appell::test;
 
 namespace {
 
-/// Both solvers on the rows of s at its state.
+/// The dense KKT and the tree solver on the rows of s, evaluated at its state.
+struct BothSolvers {
+  explicit BothSolvers(const System& s)
+      : list(s.list()), data(s.model), cd(s.model, list), kkt(s.model, list), tree(s.model, list) {
+    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+  }
+  ConstraintList list;
+  Data data;
+  ConstraintData cd;
+  KktSolver kkt;
+  TreeSolver tree;
+};
+
+/// Both solvers' accelerations and reactions.
 void solveBoth(const System& s, ConstrainedResult& ko, ConstrainedResult& to) {
-  const ConstraintList list = s.list();
-  Data data(s.model);
-  ConstraintData cd(s.model, list);
-  evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-  KktSolver kkt(s.model, list);
-  TreeSolver tree(s.model, list);
-  kkt.solve(s.model, data, list, cd, s.q, s.v, s.tau, ko);
-  tree.solve(s.model, data, list, cd, s.q, s.v, s.tau, to);
+  BothSolvers b(s);
+  b.kkt.solve(s.model, b.data, b.list, b.cd, s.q, s.v, s.tau, ko);
+  b.tree.solve(s.model, b.data, b.list, b.cd, s.q, s.v, s.tau, to);
+}
+
+/// Both solvers' velocity projections of s's state: projected v and impulse μ.
+void projectBoth(const System& s, VecX& vk, VecX& mk, VecX& vt, VecX& mt) {
+  BothSolvers b(s);
+  vk = vt = s.v;
+  ASSERT_TRUE(b.kkt.projectVelocity(s.model, b.data, b.list, b.cd, s.q, vk, mk)) << b.kkt.lastError();
+  ASSERT_TRUE(b.tree.projectVelocity(s.model, b.data, b.list, b.cd, s.q, vt, mt))
+      << b.tree.lastError();
 }
 
 }  // namespace
@@ -112,15 +129,8 @@ TEST(TreeSolver, MinimumNormLambdaWhenRedundancySpansBodies) {
         EXPECT_LT(relErr(to.lambda, ko.lambda), 1e-10);
 
         // The impulse of the velocity projection: the same minimum-norm μ.
-        const ConstraintList list = s.list();
-        Data data(s.model);
-        ConstraintData cd(s.model, list);
-        evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-        KktSolver kkt(s.model, list);
-        TreeSolver tree(s.model, list);
-        VecX vk = s.v, vt = s.v, mk, mt;
-        ASSERT_TRUE(kkt.projectVelocity(s.model, data, list, cd, s.q, vk, mk));
-        ASSERT_TRUE(tree.projectVelocity(s.model, data, list, cd, s.q, vt, mt));
+        VecX vk, vt, mk, mt;
+        projectBoth(s, vk, mk, vt, mt);
         EXPECT_LT(relErr(vt, vk), 1e-10);
         EXPECT_LT(relErr(mt, mk), 1e-10);
         ++cases;
