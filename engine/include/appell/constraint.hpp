@@ -82,6 +82,16 @@ class Constraint {
   virtual bool holonomic(int k) const = 0;
   /// Rows given over v (A_joint …) rather than as body covectors.
   virtual bool jointSpace() const { return false; }
+  /// A unilateral constraint (a contact, a joint limit) can open. Its row
+  /// unilateralRow() is ġ of a gap g(q) ≥ 0 whose multiplier may only push
+  /// (λ ≥ 0, the force along the row's direction): while closed all its rows
+  /// hold; it opens when that λ would pull (lift-off) and closes when g
+  /// reaches 0 (touchdown) — docs/contacts.md §7. −1: bilateral, always closed.
+  virtual int unilateralRow() const { return -1; }
+  bool unilateral() const { return unilateralRow() >= 0; }
+  /// Newton's coefficient of restitution on the unilateral row at an impact
+  /// (0: plastic). Only read when unilateral().
+  virtual double restitution() const { return 0; }
   /// Constant-size storage the block needs (called once, outside the step).
   virtual void reserve(const Model& model, RowBlock& block) const;
   /// Writes the rows at (q, v, t). `data` holds forwardKinematics(q, v).

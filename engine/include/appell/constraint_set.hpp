@@ -42,6 +42,16 @@ struct ConstraintData {
   VecX gap;                        ///< m, holonomic gaps (0 for other rows)
   std::vector<char> holonomic;     ///< m, row is ġ of a gap
   std::vector<int> row_constraint; ///< m, owning constraint
+  /// Per constraint: closed (1) or open (0). Every constraint is evaluated
+  /// (an open contact still reports its gap and frame), but the rows of an
+  /// open one are not constraints: solvers give them λ = 0, the dense form
+  /// holds zero rows for them, projections and residuals skip them. Only
+  /// unilateral constraints open (the simulator's active set, contact_events).
+  std::vector<char> active;
+  int m_active = 0;                ///< rows of the closed constraints
+  bool isActive(int constraint) const { return active[constraint] != 0; }
+  /// Opens or closes a constraint (keeps m_active); no allocation.
+  void setActive(int constraint, bool closed);
   bool singular = false;           ///< some constraint reported singular geometry
   std::string singular_reason;     ///< "<constraint>: <reason>" of the first one
 

@@ -20,6 +20,8 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
     }
     m += constraints[k]->rows();
   }
+  active.assign(constraints.size(), 1);
+  m_active = m;
   b = VecX::Zero(m);
   gap = VecX::Zero(m);
   if (dense == DenseRows::Sized) {
@@ -28,6 +30,14 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
     abias = VecX::Zero(m);
     J = MatX::Zero(6, model.nv);
   }
+}
+
+void ConstraintData::setActive(int constraint, bool closed) {
+  if (isActive(constraint) == closed) return;
+  active[constraint] = closed ? 1 : 0;
+  const int rows = constraint + 1 < static_cast<int>(offset.size()) ? offset[constraint + 1] - offset[constraint]
+                                                                   : m - offset[constraint];
+  m_active += closed ? rows : -rows;
 }
 
 void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList& constraints,
@@ -40,11 +50,35 @@ void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList
     RowBlock& blk = cd.blocks[k];
     blk.singular = false;
     c.evaluate(model, data, t, q, v, blk);
-    if (blk.singular && !cd.singular) {
+    // An open contact's rows are not used: its singular geometry (a flat disk
+    // far above the ground) stops nothing.
+    if (blk.singular && cd.isActive(static_cast<int>(k)) && !cd.singular) {
       cd.singular = true;
       cd.singular_reason = c.name() + ": " + blk.singular_reason;
     }
     const int o = cd.offset[k], m = c.rows();
+    if (!cd.isActive(static_cast<int>(k))) {
+      // Open: zero rows (no constraint on v, λ = 0 in every formulation); the
+      // gap and the frame stay — the clearance touchdown is detected on.
+      if (c.jointSpace()) {
+        blk.A_joint.setZero();
+        blk.b_joint.setZero();
+        blk.abias_joint.setZero();
+      } else {
+        blk.Wa.setZero();
+        blk.Wb.setZero();
+        blk.b.setZero();
+        blk.kappa.setZero();
+      }
+      cd.b.segment(o, m).setZero();
+      if (c.jointSpace()) {
+        if (blk.gap.size() == m) cd.gap.segment(o, m) = blk.gap;
+        else cd.gap.segment(o, m).setZero();
+      } else {
+        cd.gap.segment(o, m) = blk.gap;
+      }
+      continue;
+    }
     if (c.jointSpace()) {
       cd.b.segment(o, m) = blk.b_joint;
       // Holonomic joint-space rows report their gaps in blk.gap (≤ 6 rows).
@@ -88,6 +122,11 @@ void assembleDenseRows(const Model& model, const Data& data, const ConstraintLis
         "(DenseRows::None)");
   for (size_t k = 0; k < constraints.size(); ++k) {
     const int o = cd.offset[k], m = constraints[k]->rows();
+    if (!cd.isActive(static_cast<int>(k))) {  // an open contact: zero rows, λ = 0
+      cd.A.middleRows(o, m).setZero();
+      cd.abias.segment(o, m).setZero();
+      continue;
+    }
     assembleConstraintRows(model, data, *constraints[k], cd.blocks[k], cd.J, cd.A.middleRows(o, m),
                            cd.abias.segment(o, m));
   }
@@ -106,6 +145,7 @@ double velocityResidual(const Data& data, const ConstraintList& constraints,
     const Constraint& c = *constraints[k];
     const RowBlock& blk = cd.blocks[k];
     const int o = cd.offset[k], m = c.rows();
+    if (!cd.isActive(static_cast<int>(k))) continue;
     if (c.jointSpace()) {
       for (int i = 0; i < m; ++i)
         r = std::max(r, std::abs(blk.A_joint.row(i).dot(v) + cd.b[o + i]));
@@ -132,7 +172,10 @@ double velocityResidual(const Model& model, Data& data, const ConstraintList& co
 }
 
 double gapResidual(const ConstraintData& cd) {
-  return cd.m == 0 ? 0.0 : cd.gap.lpNorm<Eigen::Infinity>();
+  double r = 0;  // closed constraints only: an open contact's gap is its clearance
+  for (int i = 0; i < cd.m; ++i)
+    if (cd.isActive(cd.row_constraint[i])) r = std::max(r, std::abs(cd.gap[i]));
+  return r;
 }
 
 }  // namespace appell

@@ -47,6 +47,11 @@ struct PositionProjector::Impl {
     for (int c : with_gaps) {
       const Constraint& con = *constraints[c];
       const int o = cdata.offset[c], m = con.rows();
+      if (!cdata.isActive(c)) {  // an open contact: its gap is a clearance, not a constraint
+        for (int r = 0; r < m; ++r)
+          if (holonomic_flags[o + r]) Ah.row(k++).setZero();
+        continue;
+      }
       assembleConstraintRows(model, data, con, cdata.blocks[c], J, Ak.topRows(m),
                              abias_k.head(m));
       for (int r = 0; r < m; ++r)
@@ -105,7 +110,10 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
   for (int it = 0;; ++it) {
     evaluateConstraintRows(model, data, constraints, cdata, t, q, w.v0);
     if (cdata.singular) return fail("singular contact geometry: " + cdata.singular_reason);
-    for (int k = 0; k < w.mh; ++k) w.g[k] = cdata.gap[w.row_map[k]];
+    for (int k = 0; k < w.mh; ++k) {
+      const int row = w.row_map[k];
+      w.g[k] = cdata.isActive(cdata.row_constraint[row]) ? cdata.gap[row] : 0.0;
+    }
     const double gmax = w.mh ? w.g.lpNorm<Eigen::Infinity>() : 0.0;
     if (!std::isfinite(gmax)) return fail("non-finite holonomic gap");
     if (it == 0) res.initial_residual = gmax;
@@ -178,6 +186,7 @@ void applyBaumgarte(const Data& data, const ConstraintList& constraints, Constra
     const Constraint& c = *constraints[k];
     RowBlock& blk = cdata.blocks[k];
     const int o = cdata.offset[k], m = c.rows();
+    if (!cdata.isActive(static_cast<int>(k))) continue;
     const int a = c.bodyA(), bb = c.bodyB();
     Vec6 Va = Vec6::Zero(), Vb = Vec6::Zero();
     if (!c.jointSpace()) {

@@ -213,7 +213,7 @@ void AppellSolver::solve(const Model& model, Data& data, const ConstraintList& c
     return;
   }
   out.rank = w.basis.rank();
-  out.redundant = w.m - out.rank;
+  out.redundant = cdata.m_active - out.rank;  // open contacts' zero rows are not redundancy
   out.lambda = w.lambda;
   out.reaction.noalias() = cdata.A.transpose() * out.lambda;
 }

@@ -115,7 +115,7 @@ void KktSolver::solve(const Model& model, Data& data, const ConstraintList& cons
   }
   w.factorRows(cdata.A, options_);
   out.rank = w.basis.rank();
-  out.redundant = m - out.rank;
+  out.redundant = cdata.m_active - out.rank;  // open contacts' zero rows are not redundancy
   // Constraint defect of the free motion: d = c − A a, c = −abias.
   w.d.noalias() = -cdata.A * w.a;
   w.d -= cdata.abias;

@@ -49,6 +49,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
       tb.body = A >= 0 ? A : B;
       tb.sign = A >= 0 ? 1.0 : -1.0;
       tb.rows = rows;
+      tb.declared = rows;
       tb.global = global;
       tb.rhs.setZero(rows);
       ws.nodes[tb.body].groups.push_back({Segment::Block, static_cast<int>(ws.blocks.size()), rows});
@@ -112,6 +113,16 @@ void checkSizes(const Model& model, const ConstraintData& cdata, const detail::T
         "TreeSolver: the model or constraint set differs from the one the solver was built for");
 }
 
+/// The active set of this solve: an open constraint's block writes no rows
+/// (its λ stays 0); an open loop row is a zero row of the Schur complement,
+/// not counted as redundant. Returns the open loop rows.
+int applyActiveSet(const ConstraintData& cdata, detail::TreeWorkspace& ws) {
+  for (auto& tb : ws.blocks) tb.rows = cdata.isActive(tb.constraint) ? tb.declared : 0;
+  int open = 0;
+  for (const auto& lr : ws.loops) open += cdata.isActive(lr.constraint) ? 0 : 1;
+  return open;
+}
+
 /// Velocity products and bias forces of the current state (ABA's first pass).
 void velocityTerms(const Model& model, const Data& data, const VecX& v, detail::TreeWorkspace& ws) {
   for (int i = 0; i < model.nbodies; ++i) {
@@ -131,6 +142,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   (void)constraints;
   auto& ws = *ws_;
   checkSizes(model, cdata, ws);
+  const int open_loops = applyActiveSet(cdata, ws);
   if (out.vdot.size() != model.nv) out.vdot.resize(model.nv);
   if (out.lambda.size() != ws.m) out.lambda.resize(ws.m);
   if (out.reaction.size() != model.nv) out.reaction.resize(model.nv);
@@ -167,10 +179,10 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     ws.last_error = out.error;
     return;
   }
-  ws.redundant += static_cast<int>(ws.loops.size()) - ws.loop_rank;
+  ws.redundant += static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank;
   out.vdot = ws.vdot;
   out.redundant = ws.redundant;
-  out.rank = ws.m - ws.redundant;
+  out.rank = cdata.m_active - ws.redundant;
   if (outputs == SolveOutputs::Accelerations) return;  // an integrator stage: v̇ is all it reads
   if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);
   out.lambda = ws.lambda;
@@ -182,6 +194,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
   (void)constraints;
   auto& ws = *ws_;
   checkSizes(model, cdata, ws);
+  const int open_loops = applyActiveSet(cdata, ws);
   ws.last_error.clear();
   if (cdata.singular) {
     ws.last_error = "singular constraint geometry: " + cdata.singular_reason;
@@ -210,7 +223,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     ws.last_error = detail::describeFailure(model, data, ws);
     return false;
   }
-  if (ws.redundant + static_cast<int>(ws.loops.size()) - ws.loop_rank > 0)
+  if (ws.redundant + static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank > 0)
     detail::minimumNorm(model, ws, ws.lambda);
   v += ws.vdot;
   impulse = -ws.lambda;  // the shared convention: v⁺ = v − M⁻¹Aᵀμ

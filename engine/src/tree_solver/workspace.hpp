@@ -90,7 +90,8 @@ struct TreeBlock {
   int constraint = -1;         ///< index in the ConstraintList / ConstraintData
   int body = -1;
   double sign = 1;             ///< +1: rows Wₐ on bodyA; −1: rows −W_b on bodyB
-  int rows = 0;
+  int rows = 0;                ///< rows in this solve: the declared ones, 0 while open
+  int declared = 0;            ///< the constraint's rows
   int global = -1;             ///< first row in ConstraintData
   KVec rhs;                    ///< right side on the gravity-shifted acceleration
 };
