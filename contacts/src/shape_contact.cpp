@@ -48,7 +48,8 @@ ContactKind contactKindFromString(const std::string& text) {
 ShapeContact::ShapeContact(ContactKind kind, int body, Shape shape, Support support,
                            const ContactOptions& options)
     : ShapeContact(ContactSpec{kind, body, std::move(shape), std::move(support),
-                               std::numeric_limits<double>::infinity(), options}) {}
+                               std::numeric_limits<double>::infinity(), true, 0.0,
+                               options}) {}
 
 ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(rowCount(spec_.kind)) {
   const ContactKind kind = spec_.kind;
@@ -72,6 +73,9 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
     fail("a support carried by a body moves with it: give a StaticMotion (its pose on the body)");
   if (!(spec_.mu >= 0))
     fail("the friction coefficient μ must be ≥ 0 (∞: no limit)");
+  if (!(spec_.restitution >= 0 && spec_.restitution <= 1))
+    fail("the restitution must lie in [0, 1] (0: plastic, 1: elastic), got " +
+         std::to_string(spec_.restitution));
   try {
     validateShape(shape);
     validateSupport(support);
@@ -132,6 +136,13 @@ RowKind ShapeContact::rowKind(int k) const {
 
 // The normal row is ġ for the signed gap g; the others are velocity rows.
 bool ShapeContact::holonomic(int k) const { return rowKind(k) == RowKind::Normal; }
+
+int ShapeContact::unilateralRow() const {
+  if (!spec_.unilateral) return -1;
+  for (int k = 0; k < rows_; ++k)
+    if (rowKind(k) == RowKind::Normal) return k;
+  return -1;
+}
 
 void ShapeContact::reserve(const Model& model, RowBlock& block) const {
   if (spec_.support.body >= model.nbodies)

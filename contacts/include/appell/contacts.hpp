@@ -61,6 +61,12 @@ struct ContactSpec {
   /// Coulomb friction coefficient (∞: no limit). The rows do not read it yet;
   /// the friction check of `appell run` does.
   double mu = std::numeric_limits<double>::infinity();
+  /// The contact can open: it lifts off when its normal force would pull and
+  /// closes when its gap reaches zero (contact_events.hpp). false: a
+  /// bilateral idealisation (a wheel on a rail that holds it down).
+  bool unilateral = true;
+  /// Newton's coefficient of restitution of its impacts, in [0, 1] (0: plastic).
+  double restitution = 0;
   ContactOptions options;
 };
 
@@ -81,6 +87,9 @@ class ShapeContact : public Constraint {
   int bodyB() const override { return spec_.support.body; }
   RowKind rowKind(int k) const override;
   bool holonomic(int k) const override;
+  /// The normal row, when the contact is unilateral (spec().unilateral).
+  int unilateralRow() const override;
+  double restitution() const override { return spec_.restitution; }
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;

@@ -5,7 +5,12 @@
 //             → velocity projection (solver.projectVelocity, M metric)
 //             → reset the integrator's FSAL stage (the state was changed)
 //             → evaluate the end state for reports (λ, contact frames,
-//               energy, residuals).
+//               energy, residuals)
+//             → unilateral constraints (contact_events.hpp): if an open one
+//               crossed its gap or a closed one's λ would pull, the step is
+//               shortened to the first such event, located by root finding,
+//               and the contact modes are decided there (impact, then the
+//               contact-force complementarity problem).
 // A step that fails (solver error, non-finite joint forces or state, step size
 // below h_min, projection failure) returns a status with the reason and leaves
 // the last good state untouched. Everything is preallocated at construction:
@@ -14,6 +19,7 @@
 #pragma once
 
 #include <appell/constrained_dynamics.hpp>
+#include <appell/contact_events.hpp>
 #include <appell/integrators.hpp>
 #include <appell/projection.hpp>
 
@@ -29,8 +35,10 @@ struct SimulatorOptions {
   ProjectionOptions projection;
   BaumgarteOptions baumgarte;      ///< off by default (projection is the method)
   /// Solve the dynamics at the end of each step, so lambda() and contact
-  /// frames describe the current state (one extra solve per step).
+  /// frames describe the current state (one extra solve per step). Needed
+  /// for lift-off detection: with it off, closed contacts never open.
   bool evaluate_end_state = true;
+  ContactEventOptions contacts;    ///< unilateral contacts: events, impacts
 };
 
 struct StepStatus {
@@ -41,6 +49,7 @@ struct StepStatus {
   int rejected = 0;
   int evaluations = 0;
   int projection_iterations = 0;
+  int events = 0;        ///< contact events at the end of this step (events())
 };
 
 struct SimulatorCounters {
@@ -49,6 +58,8 @@ struct SimulatorCounters {
   long evaluations = 0;            ///< dynamics solves by the integrator
   long failed = 0;                 ///< step() calls that returned !ok
   long projection_iterations = 0;  ///< Newton iterations of the position projection
+  long events = 0;                 ///< contact events (touchdown, bounce, lift-off)
+  long event_steps = 0;            ///< extra steps taken to locate events
 };
 
 class Simulator {
@@ -65,8 +76,12 @@ class Simulator {
   ~Simulator();
 
   /// Sets the state (throws std::invalid_argument on wrong sizes or non-finite
-  /// values) and evaluates it for reports; does not project.
-  void setState(double t, const VecX& q, const VecX& v);
+  /// values) and evaluates it for reports; does not project. Unilateral
+  /// constraints start open where their gap exceeds the touching tolerance;
+  /// the touching ones get their modes decided (an impact if they approach).
+  /// Returns false (and lastStateError()) if no consistent mode was found.
+  bool setState(double t, const VecX& q, const VecX& v);
+  const std::string& lastStateError() const { return state_error_; }
   /// Projects the current state onto the constraints (e.g. initial conditions).
   StepStatus projectState();
   void setJointForces(JointForces tau);
@@ -98,6 +113,11 @@ class Simulator {
   int partitionChanges() const;
   const PositionProjectionResult& lastProjection() const { return projection_; }
   const VecX& lastImpulse() const { return impulse_; }
+  /// Contact events of the last step() / setState(), in time order (the
+  /// buffer is reused: copy what you keep).
+  const std::vector<ContactEvent>& events() const { return events_; }
+  /// Whether unilateral constraint `c` is closed now.
+  bool isClosed(int constraint) const { return cdata_->isActive(constraint); }
   const SimulatorCounters& counters() const { return counters_; }
 
   const Model& model() const { return model_; }
@@ -110,6 +130,20 @@ class Simulator {
   StepStatus fail(StepStatus st, std::string message);
   bool evaluateEndState(std::string& error);
   void restore();
+  // Unilateral constraints (simulator/contact_events.cpp).
+  void setUpUnilateral();
+  int crossedConstraint() const;
+  StepStatus locateAndHandleEvent(StepStatus st, double h);
+  double eventFunction(int u);
+  bool restepTo(double tau, StepStatus& st);
+  bool decideModes(std::string& error);
+  bool projectAfterModes(std::string& error);
+  bool impactPhase(std::string& error);
+  bool forcePhase(std::string& error);
+  void saveCandidateRows();
+  double rowVelocity(int u) const;
+  double rowAcceleration(int u) const;
+  void logEvent(ContactEventKind kind, int u, double before, double after, double impulse);
 
   const Model& model_;
   ConstraintList constraints_;
@@ -129,6 +163,9 @@ class Simulator {
   double kinetic_ = 0, potential_ = 0, velocity_residual_ = 0, gap_residual_ = 0;
   double h_suggest_ = 0;
   SimulatorCounters counters_;
+  std::unique_ptr<detail::UnilateralState> uni_;  // sized once: contact_events.cpp
+  std::vector<ContactEvent> events_;
+  std::string state_error_;
 };
 
 }  // namespace appell

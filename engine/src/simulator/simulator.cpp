@@ -2,69 +2,13 @@
 #include <appell/dynamics.hpp>
 #include <appell/simulator.hpp>
 
+#include "simulator/simulator_internal.hpp"
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 namespace appell {
-
-// v̇ = f(t, q, v): joint forces, constraint rows, the solver. Failures are
-// remembered (with the reason) and reported as "not admissible" to the
-// integrator, which then rejects the step.
-class Simulator::Field final : public AccelerationField {
- public:
-  explicit Field(Simulator& s) : s_(s), tau_(VecX::Zero(s.model_.nv)) {}
-
-  bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) override {
-    Simulator& s = s_;
-    tau_.setZero();
-    if (s.tau_fn_) {
-      s.tau_fn_(t, q, v, tau_);
-      if (tau_.size() != s.model_.nv || !tau_.allFinite()) {
-        record("the joint-force callback returned a non-finite or wrongly sized tau", t);
-        return false;
-      }
-    }
-    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
-    if (s.options_.baumgarte.enabled)
-      applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
-                     s.options_.baumgarte.beta);
-    s.solver_->solve(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, tau_, stage_,
-                     SolveOutputs::Accelerations);
-    if (!stage_.ok) {
-      record(stage_.error, t);
-      return false;
-    }
-    if (!stage_.vdot.allFinite()) {
-      record("the solver returned a non-finite acceleration", t);
-      return false;
-    }
-    vdot = stage_.vdot;
-    return true;
-  }
-
-  void clear() {
-    failed_ = false;
-    message_.clear();
-  }
-  bool failed() const { return failed_; }
-  const std::string& message() const { return message_; }
-
- private:
-  void record(const std::string& why, double t) {
-    if (failed_) return;  // keep the first reason
-    failed_ = true;
-    std::ostringstream os;
-    os << why << " (at t = " << t << ")";
-    message_ = os.str();
-  }
-
-  Simulator& s_;
-  VecX tau_;
-  ConstrainedResult stage_;
-  bool failed_ = false;
-  std::string message_;
-};
 
 Simulator::Simulator(const Model& model, ConstraintList constraints,
                      std::unique_ptr<ConstrainedSolver> solver, IntegratorType integrator,
@@ -80,6 +24,7 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
       model_, constraints_, solver_->usesDenseRows() ? DenseRows::Sized : DenseRows::None);
   projector_ = std::make_unique<PositionProjector>(model_, constraints_, options_.projection);
   field_ = std::make_unique<Field>(*this);
+  setUpUnilateral();
   q_ = neutralConfiguration(model_);
   v_ = VecX::Zero(model_.nv);
   q_prev_ = q_;
@@ -99,7 +44,7 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
 
 Simulator::~Simulator() = default;
 
-void Simulator::setState(double t, const VecX& q, const VecX& v) {
+bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   if (q.size() != model_.nq || v.size() != model_.nv)
     throw std::invalid_argument("Simulator::setState: q must have size nq = " +
                                 std::to_string(model_.nq) + " and v size nv = " +
@@ -111,8 +56,22 @@ void Simulator::setState(double t, const VecX& q, const VecX& v) {
   v_ = v;
   integrator_->reset();
   h_suggest_ = 0;
+  events_.clear();
+  state_error_.clear();
+  if (uni_ && options_.contacts.enabled) {
+    // A new state: unilateral constraints with clearance start open, the
+    // touching ones get their modes decided (impact, then forces).
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    for (auto& r : uni_->rows) {
+      r.lifting = r.touching_down = false;
+      cdata_->setActive(r.c, cdata_->gap[r.global] <= options_.contacts.gap_tol);
+    }
+    if (!decideModes(state_error_)) state_error_ = "initial contact modes: " + state_error_;
+    integrator_->reset();
+  }
   std::string error;
   evaluateEndState(error);
+  return state_error_.empty();
 }
 
 void Simulator::setJointForces(JointForces tau) { tau_fn_ = std::move(tau); }
@@ -195,6 +154,7 @@ StepStatus Simulator::step(double h) {
   t_prev_ = t_;
   q_prev_ = q_;
   v_prev_ = v_;
+  events_.clear();
   field_->clear();
   const StepResult r = integrator_->step(*field_, t_, q_, v_, h);
   st.h_taken = r.h_taken;
@@ -219,7 +179,7 @@ StepStatus Simulator::step(double h) {
     counters_.projection_iterations += projection_.iterations;
     if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
   }
-  if (options_.project_velocities && cdata_->m > 0) {
+  if (options_.project_velocities && cdata_->m_active > 0) {
     if (!options_.project_positions)
       evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_))
@@ -229,6 +189,14 @@ StepStatus Simulator::step(double h) {
 
   std::string error;
   if (!evaluateEndState(error)) return fail(st, error);
+  // Unilateral constraints: a gap or a normal force that changed sign over
+  // the step means an event inside it (contact_events.cpp).
+  if (uni_ && options_.contacts.enabled && crossedConstraint() >= 0) {
+    st = locateAndHandleEvent(st, st.h_taken);
+    if (!st.ok) return st;
+  } else if (uni_) {
+    uni_->zero_events = 0;
+  }
   ++counters_.steps;
   return st;
 }

@@ -1,0 +1,446 @@
+// Unilateral constraints in the simulator: event detection and location, and
+// the mode decision at an event (impact, then contact forces). The
+// mathematics and the references are in contact_events.hpp.
+#include <appell/kinematics.hpp>
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace appell {
+
+std::span<const NamedValue<ContactEventKind>> contactEventKindTable() {
+  static const NamedValue<ContactEventKind> table[] = {
+      {ContactEventKind::Touchdown, "touchdown", {}, "an open contact's gap reached 0: it closed"},
+      {ContactEventKind::Bounce, "bounce", {}, "it touched down and rebounded (restitution)"},
+      {ContactEventKind::LiftOff, "lift_off", {"liftoff"}, "a closed contact's normal force reached 0: it opened"},
+  };
+  return table;
+}
+
+const char* toString(ContactEventKind kind) {
+  for (const auto& e : contactEventKindTable())
+    if (e.value == kind) return e.name;
+  return "?";
+}
+
+
+using detail::UnilateralRow;
+
+void Simulator::setUpUnilateral() {
+  for (int c = 0; c < static_cast<int>(constraints_.size()); ++c) {
+    const Constraint& con = *constraints_[c];
+    if (!con.unilateral()) continue;
+    if (!uni_) uni_ = std::make_unique<detail::UnilateralState>();
+    UnilateralRow r;
+    r.c = c;
+    r.row = con.unilateralRow();
+    if (r.row >= con.rows())
+      throw std::invalid_argument("Simulator: constraint '" + con.name() +
+                                  "' names unilateral row " + std::to_string(r.row) + " of " +
+                                  std::to_string(con.rows()));
+    const double e = con.restitution();
+    if (!(e >= 0 && e <= 1))
+      throw std::invalid_argument("Simulator: constraint '" + con.name() +
+                                  "' has restitution " + std::to_string(e) + " outside [0, 1]");
+    r.global = cdata_->offset[c] + r.row;
+    r.joint = con.jointSpace();
+    r.a = con.bodyA();
+    r.b = con.bodyB();
+    if (r.joint) r.a_joint = VecX::Zero(model_.nv);
+    uni_->rows.push_back(r);
+  }
+  if (!uni_) return;
+  auto& u = *uni_;
+  u.q0 = q_;
+  u.v0 = v_;
+  u.vplus = v_;
+  u.vdot = VecX::Zero(model_.nv);
+  u.impulse = VecX::Zero(cdata_->m);
+  u.res.vdot = VecX::Zero(model_.nv);
+  u.res.lambda = VecX::Zero(cdata_->m);
+  u.res.reaction = VecX::Zero(model_.nv);
+  events_.reserve(64);
+}
+
+// ---------------------------------------------------------------- detection
+
+/// The first unilateral constraint whose event function changed sign over
+/// the step just taken (end state in cdata_ and result_), or −1.
+int Simulator::crossedConstraint() const {
+  for (int k = 0; k < static_cast<int>(uni_->rows.size()); ++k) {
+    const UnilateralRow& r = uni_->rows[k];
+    if (cdata_->isActive(r.c)) {
+      if (options_.evaluate_end_state && result_.lambda[r.global] < -options_.contacts.force_tol)
+        return k;
+    } else if (cdata_->gap[r.global] < 0) {
+      return k;
+    }
+  }
+  return -1;
+}
+
+/// Integrates from the step's start by τ (no projection): the state the
+/// event functions are evaluated on. τ = 0 is the start itself.
+bool Simulator::restepTo(double tau, StepStatus& st) {
+  auto& u = *uni_;
+  t_ = u.t0;
+  q_ = u.q0;
+  v_ = u.v0;
+  if (tau <= 0) return true;
+  integrator_->reset();
+  field_->clear();
+  const StepResult r = integrator_->step(*field_, t_, q_, v_, tau);
+  st.evaluations += r.evaluations;
+  counters_.evaluations += r.evaluations;
+  ++counters_.event_steps;
+  return r.ok && q_.allFinite() && v_.allFinite();
+}
+
+/// Event function of unilateral row k at the current (t_, q_, v_): the gap
+/// while open, λᵤ while closed (one solve).
+double Simulator::eventFunction(int k) {
+  const UnilateralRow& r = uni_->rows[k];
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  if (!cdata_->isActive(r.c)) return cdata_->gap[r.global];
+  tau_.setZero();
+  if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
+  solver_->solve(model_, *data_, constraints_, *cdata_, q_, v_, tau_, uni_->res);
+  return uni_->res.ok ? uni_->res.lambda[r.global] : std::numeric_limits<double>::quiet_NaN();
+}
+
+StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
+  auto& u = *uni_;
+  const ContactEventOptions& o = options_.contacts;
+  // The step's start: the last good state (t_prev_ …), saved by step().
+  u.t0 = t_prev_;
+  u.q0 = q_prev_;
+  u.v0 = v_prev_;
+  int k = crossedConstraint();
+  double hi = h;
+  for (int round = 0; k >= 0 && round < static_cast<int>(u.rows.size()) + 1; ++round) {
+    // Illinois (modified regula falsi) on φ_k(τ) over [0, hi]: φ(0) ≥ 0 > φ(hi).
+    double a = 0, b = hi;
+    if (!restepTo(a, st)) return fail(st, "event location: the step from the last state failed");
+    double fa = eventFunction(k);
+    if (!restepTo(b, st)) return fail(st, "event location: the step from the last state failed");
+    b = t_ - u.t0;
+    double fb = eventFunction(k);
+    if (!std::isfinite(fa) || !std::isfinite(fb))
+      return fail(st, "event location: the event function of '" +
+                          constraints_[u.rows[k].c]->name() + "' is not finite");
+    if (fa <= 0) {
+      b = 0;  // already at (or past) the event at the start: decide there
+    } else {
+      int side = 0;
+      for (int it = 0; it < o.max_locate_iterations && b - a > o.time_tol; ++it) {
+        double c = (a * fb - b * fa) / (fb - fa);
+        if (!(c > a && c < b)) c = 0.5 * (a + b);
+        if (!restepTo(c, st)) return fail(st, "event location: a shortened step failed");
+        c = t_ - u.t0;  // an adaptive method may have taken less than asked
+        const double fc = eventFunction(k);
+        if (!std::isfinite(fc)) return fail(st, "event location: non-finite event function");
+        if (fc > 0) {
+          a = c;
+          fa = fc;
+          if (side == 1) fb *= 0.5;
+          side = 1;
+        } else {
+          b = c;
+          fb = fc;
+          if (side == -1) fa *= 0.5;
+          side = -1;
+        }
+        if (fc == 0) break;
+      }
+    }
+    // Did another contact cross before τ = b? Then that one is first.
+    if (!restepTo(b, st)) return fail(st, "event location: a shortened step failed");
+    hi = t_ - u.t0;
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    int earlier = -1;
+    for (int j = 0; j < static_cast<int>(u.rows.size()) && earlier < 0; ++j) {
+      if (j == k) continue;
+      const UnilateralRow& r = u.rows[j];
+      if (!cdata_->isActive(r.c) && cdata_->gap[r.global] < -o.gap_tol) earlier = j;
+    }
+    if (earlier < 0 && options_.evaluate_end_state) {
+      for (int j = 0; j < static_cast<int>(u.rows.size()) && earlier < 0; ++j) {
+        if (j == k || !cdata_->isActive(u.rows[j].c)) continue;
+        if (eventFunction(j) < -o.force_tol) earlier = j;
+      }
+    }
+    if (earlier < 0) break;
+    k = earlier;
+  }
+  if (hi <= 0) {
+    if (++u.zero_events > 2)
+      return fail(st, "contact '" + constraints_[u.rows[k].c]->name() +
+                          "' switches at every step start: no consistent contact mode");
+  } else {
+    u.zero_events = 0;
+  }
+  // The step to the event: q_, v_ hold the integrated state at t0 + hi.
+  for (auto& r : u.rows) {
+    r.lifting = false;
+    r.touching_down = false;
+  }
+  UnilateralRow& ev = u.rows[k];
+  if (cdata_->isActive(ev.c)) ev.lifting = true;
+  else ev.touching_down = true;
+  st.h_taken = hi;
+  // Drift control on the old set, the modes, then drift control on the new set.
+  std::string error;
+  if (options_.project_positions) {
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
+    if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
+  }
+  if (!decideModes(error)) return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+  if (!projectAfterModes(error)) return fail(st, error);
+  integrator_->reset();
+  if (!evaluateEndState(error)) return fail(st, error);
+  st.events = static_cast<int>(events_.size());
+  counters_.events += st.events;
+  return st;
+}
+
+/// The step's drift control with the new active set.
+bool Simulator::projectAfterModes(std::string& error) {
+  if (options_.project_positions) {
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
+    if (!projection_.ok) {
+      error = "position projection failed: " + projection_.error;
+      return false;
+    }
+  }
+  if (options_.project_velocities && cdata_->m_active > 0) {
+    if (!options_.project_positions)
+      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
+      error = "velocity projection failed: " + solver_->lastError();
+      return false;
+    }
+  }
+  return true;
+}
+
+// ------------------------------------------------------------ mode decision
+
+/// γ = ġ of unilateral row k from its saved row, at data_'s velocities.
+double Simulator::rowVelocity(int k) const {
+  const UnilateralRow& r = uni_->rows[k];
+  if (r.joint) return r.a_joint.dot(v_) + r.bval;
+  double g = r.bval;
+  if (r.a >= 0) g += r.wa.dot(data_->oMi[r.a].act(data_->v[r.a]));
+  if (r.b >= 0) g -= r.wb.dot(data_->oMi[r.b].act(data_->v[r.b]));
+  return g;
+}
+
+/// γ̇ of unilateral row k, data_ holding forwardKinematics(q, v, v̇).
+double Simulator::rowAcceleration(int k) const {
+  const UnilateralRow& r = uni_->rows[k];
+  if (r.joint) return r.a_joint.dot(uni_->vdot) + r.abias;
+  double g = r.kappa;
+  if (r.a >= 0) g += r.wa.dot(spatialAccelerationWorld(*data_, r.a));
+  if (r.b >= 0) g -= r.wb.dot(spatialAccelerationWorld(*data_, r.b));
+  return g;
+}
+
+/// Closes every touching contact, evaluates the rows at (t_, q_, v_) and keeps
+/// a copy of each unilateral row; the active set is left all-touching-closed.
+void Simulator::saveCandidateRows() {
+  auto& u = *uni_;
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  for (auto& r : u.rows) {
+    r.gap = cdata_->gap[r.global];
+    r.touching = !r.bounced && (cdata_->isActive(r.c) ||
+                                std::abs(r.gap) <= options_.contacts.gap_tol || r.touching_down);
+    if (r.touching) cdata_->setActive(r.c, true);
+  }
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  for (auto& r : u.rows) {
+    if (!r.touching) continue;
+    const RowBlock& blk = cdata_->blocks[r.c];
+    if (r.joint) {
+      r.a_joint = blk.A_joint.row(r.row).transpose();
+      r.bval = blk.b_joint[r.row];
+      r.abias = blk.abias_joint[r.row];
+    } else {
+      r.wa = blk.Wa.row(r.row).transpose();
+      r.wb = blk.Wb.row(r.row).transpose();
+      r.bval = blk.b[r.row];
+      r.kappa = blk.kappa[r.row];
+    }
+  }
+}
+
+void Simulator::logEvent(ContactEventKind kind, int k, double before, double after,
+                         double impulse) {
+  const UnilateralRow& r = uni_->rows[k];
+  ContactEvent e;
+  e.t = t_;
+  e.constraint = r.c;
+  e.kind = kind;
+  e.speed_before = before;
+  e.speed_after = after;
+  e.normal_impulse = impulse;
+  e.tangential_impulse = r.tangential;
+  events_.push_back(e);
+}
+
+/// Impact: Newton's law on the touching contacts that approach, with the
+/// velocity projection as the impulse solve, by principal pivoting.
+bool Simulator::impactPhase(std::string& error) {
+  auto& u = *uni_;
+  const ContactEventOptions& o = options_.contacts;
+  forwardKinematics(model_, *data_, q_, v_);
+  bool any = false;
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    auto& r = u.rows[k];
+    r.impulse = r.tangential = 0;
+    r.target = 0;
+    if (!r.touching) continue;
+    r.gamma = rowVelocity(k);
+    if (r.gamma < -o.speed_tol) {
+      any = true;
+      const double e = constraints_[r.c]->restitution();
+      r.target = r.gamma < -o.rest_speed ? e * r.gamma : 0.0;
+    }
+    r.in_set = r.was_closed || r.gamma < -o.speed_tol;
+  }
+  if (!any) return true;
+  for (int it = 0;; ++it) {
+    if (it == o.max_mode_iterations) {
+      error = "impact: no consistent set of contacts after " + std::to_string(it) + " pivots";
+      return false;
+    }
+    for (auto& r : u.rows)
+      if (r.touching) cdata_->setActive(r.c, r.in_set);
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    for (auto& r : u.rows) {
+      if (!r.touching || !r.in_set) continue;
+      // Shift the row so that the projection makes γ⁺ = −e γ⁻.
+      cdata_->b[r.global] += r.target;
+      RowBlock& blk = cdata_->blocks[r.c];
+      if (r.joint) blk.b_joint[r.row] += r.target;
+      else blk.b[r.row] += r.target;
+    }
+    u.vplus = v_;
+    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
+      error = "impact: the impulse solve failed: " + solver_->lastError();
+      return false;
+    }
+    std::swap(v_, u.vplus);  // rowVelocity reads v_ and data_ at v⁺
+    forwardKinematics(model_, *data_, q_, v_);
+    double scale = 0;
+    for (const auto& r : u.rows)
+      if (r.touching && r.in_set) scale = std::max(scale, std::abs(u.impulse[r.global]));
+    int flip = -1;
+    for (int k = 0; k < static_cast<int>(u.rows.size()) && flip < 0; ++k) {
+      auto& r = u.rows[k];
+      if (!r.touching) continue;
+      if (r.in_set) {
+        r.impulse = -u.impulse[r.global];  // v⁺ = v − M⁻¹Aᵀμ: the push along the row is −μ
+        if (r.impulse < -1e-10 * (1 + scale)) flip = k;
+      } else if (rowVelocity(k) + r.target < -o.speed_tol) {
+        flip = k;
+      }
+    }
+    if (flip < 0) break;
+    std::swap(v_, u.vplus);  // back to the pre-impact velocity
+    u.rows[flip].in_set = !u.rows[flip].in_set;
+  }
+  // v_ is v⁺. Contacts that took an impulse with restitution rebound: open.
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    auto& r = u.rows[k];
+    if (!r.touching || !r.in_set) continue;
+    const Constraint& con = *constraints_[r.c];
+    double t2 = 0;
+    for (int i = 0; i < con.rows(); ++i)
+      if (isTangential(con.rowKind(i))) t2 += std::pow(u.impulse[cdata_->offset[r.c] + i], 2);
+    r.tangential = std::sqrt(t2);
+    const double after = rowVelocity(k);
+    if (r.target < 0) {
+      logEvent(ContactEventKind::Bounce, k, r.gamma, after, r.impulse);
+      r.touching = false;  // separating: not a candidate of the force problem
+      r.bounced = true;
+      cdata_->setActive(r.c, false);
+    } else if (r.gamma < -o.speed_tol) {
+      logEvent(ContactEventKind::Touchdown, k, r.gamma, after, r.impulse);
+      r.touching_down = false;  // logged
+      r.was_closed = true;      // closed plastically: the force problem starts from it
+    }
+  }
+  return true;
+}
+
+/// Contact forces: λᵤ ≥ 0 for the closed, γ̇ ≥ 0 for the open touching
+/// contacts, by principal pivoting with one dynamics solve per pivot.
+bool Simulator::forcePhase(std::string& error) {
+  auto& u = *uni_;
+  const ContactEventOptions& o = options_.contacts;
+  const double acc_tol = o.force_tol * (1 + model_.gravity.norm());
+  bool any = false;
+  for (auto& r : u.rows) {
+    if (!r.touching) continue;
+    any = true;
+    r.in_set = !r.lifting && (r.was_closed || r.touching_down);
+  }
+  if (!any) return true;
+  saveCandidateRows();  // rows at the post-impact velocity (κ depends on v)
+  for (int it = 0;; ++it) {
+    if (it == o.max_mode_iterations) {
+      error = "contact modes: no consistent set of contacts after " + std::to_string(it) +
+              " pivots (a Painlevé-type configuration?)";
+      return false;
+    }
+    for (auto& r : u.rows)
+      if (r.touching) cdata_->setActive(r.c, r.in_set);
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    tau_.setZero();
+    if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
+    solver_->solve(model_, *data_, constraints_, *cdata_, q_, v_, tau_, u.res);
+    if (!u.res.ok) {
+      error = "contact modes: " + u.res.error;
+      return false;
+    }
+    u.vdot = u.res.vdot;
+    forwardKinematics(model_, *data_, q_, v_, u.vdot);
+    int flip = -1;
+    for (int k = 0; k < static_cast<int>(u.rows.size()) && flip < 0; ++k) {
+      const auto& r = u.rows[k];
+      if (!r.touching) continue;
+      if (r.in_set ? u.res.lambda[r.global] < -o.force_tol : rowAcceleration(k) < -acc_tol)
+        flip = k;
+    }
+    if (flip < 0) break;
+    u.rows[flip].in_set = !u.rows[flip].in_set;
+  }
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    const auto& r = u.rows[k];
+    if (!r.touching) continue;
+    if (r.was_closed && !r.in_set) logEvent(ContactEventKind::LiftOff, k, 0, 0, 0);
+    if (!r.was_closed && r.in_set) logEvent(ContactEventKind::Touchdown, k, r.gamma, 0, 0);
+  }
+  return true;
+}
+
+/// Decides the mode of every touching unilateral constraint at (t_, q_, v_):
+/// open the ones with clearance, impact the approaching ones, then solve for
+/// the contact forces. Leaves the active set in cdata_.
+bool Simulator::decideModes(std::string& error) {
+  auto& u = *uni_;
+  for (auto& r : u.rows) {
+    r.was_closed = cdata_->isActive(r.c);
+    r.bounced = false;
+  }
+  saveCandidateRows();
+  for (auto& r : u.rows)
+    if (!r.touching) cdata_->setActive(r.c, false);
+  return impactPhase(error) && forcePhase(error);
+}
+
+}  // namespace appell

@@ -1,0 +1,103 @@
+// The simulator's private parts, shared by simulator.cpp (the step) and
+// contact_events.cpp (unilateral constraints): the acceleration field the
+// integrator calls, and the per-contact workspace of the event handling.
+#pragma once
+
+#include <appell/simulator.hpp>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace appell {
+
+// v̇ = f(t, q, v): joint forces, constraint rows, the solver. Failures are
+// remembered (with the reason) and reported as "not admissible" to the
+// integrator, which then rejects the step.
+class Simulator::Field final : public AccelerationField {
+ public:
+  explicit Field(Simulator& s) : s_(s), tau_(VecX::Zero(s.model_.nv)) {}
+
+  bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) override {
+    Simulator& s = s_;
+    tau_.setZero();
+    if (s.tau_fn_) {
+      s.tau_fn_(t, q, v, tau_);
+      if (tau_.size() != s.model_.nv || !tau_.allFinite()) {
+        record("the joint-force callback returned a non-finite or wrongly sized tau", t);
+        return false;
+      }
+    }
+    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
+    if (s.options_.baumgarte.enabled)
+      applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
+                     s.options_.baumgarte.beta);
+    s.solver_->solve(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, tau_, stage_,
+                     SolveOutputs::Accelerations);
+    if (!stage_.ok) {
+      record(stage_.error, t);
+      return false;
+    }
+    if (!stage_.vdot.allFinite()) {
+      record("the solver returned a non-finite acceleration", t);
+      return false;
+    }
+    vdot = stage_.vdot;
+    return true;
+  }
+
+  void clear() {
+    failed_ = false;
+    message_.clear();
+  }
+  bool failed() const { return failed_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  void record(const std::string& why, double t) {
+    if (failed_) return;  // keep the first reason
+    failed_ = true;
+    std::ostringstream os;
+    os << why << " (at t = " << t << ")";
+    message_ = os.str();
+  }
+
+  Simulator& s_;
+  VecX tau_;
+  ConstrainedResult stage_;
+  bool failed_ = false;
+  std::string message_;
+};
+
+namespace detail {
+
+/// Per unilateral constraint: where its row is, and a copy of that row as
+/// evaluated with the contact closed (an open contact's block holds zero
+/// rows), to measure its normal velocity and acceleration while it is open.
+struct UnilateralRow {
+  int c = -1, row = -1, global = -1;
+  bool joint = false;
+  int a = -1, b = -1;
+  Vec6 wa = Vec6::Zero(), wb = Vec6::Zero();
+  double bval = 0, kappa = 0, abias = 0;
+  VecX a_joint;
+  double gap = 0;         // at the decision's state
+  double gamma = 0;       // normal velocity before the impact
+  double target = 0;      // e γ⁻: the impact shifts the row to γ⁺ = −e γ⁻
+  double impulse = 0, tangential = 0;
+  bool touching = false, in_set = false, was_closed = false, lifting = false, touching_down = false;
+  bool bounced = false;   // rebounded at this event: open, not a force candidate
+  double gap_start = 0;   // gap at the start of the step (open contacts)
+};
+
+struct UnilateralState {
+  std::vector<UnilateralRow> rows;
+  VecX q0, v0, vplus, vdot, impulse;
+  double t0 = 0;
+  ConstrainedResult res;
+  int zero_events = 0;    // consecutive events at the very start of a step
+};
+
+}  // namespace detail
+
+}  // namespace appell

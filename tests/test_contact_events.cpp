@@ -1,0 +1,184 @@
+// Unilateral contacts: touchdown, impacts, bouncing and lift-off as events
+// (contact_events.hpp), against closed-form motions of a ball.
+#include <gtest/gtest.h>
+
+#include <appell/simulator.hpp>
+
+#include "ball.hpp"
+
+#include <cmath>
+
+using namespace appell;
+using namespace appell::scenes;
+
+namespace {
+
+constexpr double kG = 9.81;
+
+IntegratorOptions tight() {
+  IntegratorOptions o;
+  o.rtol = 1e-12;
+  o.atol = 1e-12;
+  o.h_max = 0.01;
+  return o;
+}
+
+/// A ball of radius r whose centre starts h above its resting height, with
+/// the given world angular velocity and horizontal centre velocity.
+BuiltScene raisedBall(double h, const Vec3& omega, const Vec3& vG, double restitution) {
+  BallParams p;
+  p.omega = omega;
+  BuiltScene s = ball(p);
+  const auto& c = static_cast<const ShapeContact&>(*s.constraints[0]);
+  ContactSpec spec = c.spec();
+  spec.restitution = restitution;
+  s.constraints[0] = makeContact(spec);
+  setFloatingPose(s.q0, 0, Vec3(p.centre.x(), p.centre.y(), p.radius + h), Mat3::Identity());
+  s.v0 = floatingVelocity(Mat3::Identity(), omega, vG);
+  return s;
+}
+
+std::vector<ContactEvent> runCollecting(Simulator& sim, double t_end, double h) {
+  std::vector<ContactEvent> all;
+  while (sim.time() < t_end - 1e-12) {
+    const StepStatus st = sim.step(std::min(h, t_end - sim.time()));
+    EXPECT_TRUE(st.ok) << st.message;
+    if (!st.ok) break;
+    all.insert(all.end(), sim.events().begin(), sim.events().end());
+  }
+  return all;
+}
+
+double centreHeight(const Simulator& sim) { return sim.q()[2]; }
+
+}  // namespace
+
+// Protects: touchdown located in time (event function = gap, root found on
+// shortened steps) for every formulation and integrator; a plastic impact
+// leaves the ball at rest on the plane.
+TEST(ContactEvents, DroppedBallTouchesDownAtTheFreeFallTime) {
+  const double h = 0.2;
+  const double t_star = std::sqrt(2 * h / kG);
+  for (IntegratorType it : {IntegratorType::DormandPrince54, IntegratorType::RK4}) {
+    for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+      BuiltScene s = raisedBall(h, Vec3::Zero(), Vec3::Zero(), 0.0);
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, tight());
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+      EXPECT_FALSE(sim.isClosed(0)) << "a ball above the plane starts with its contact open";
+      const auto events = runCollecting(sim, 0.4, 1e-2);
+      ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it);
+      EXPECT_EQ(events[0].kind, ContactEventKind::Touchdown);
+      EXPECT_NEAR(events[0].t, t_star, 1e-10) << toString(f) << " " << toString(it);
+      EXPECT_NEAR(events[0].speed_before, -kG * t_star, 1e-8);
+      // Plastic: the impulse takes the momentum m v.
+      EXPECT_NEAR(events[0].normal_impulse, 0.5 * kG * t_star, 1e-8);
+      EXPECT_TRUE(sim.isClosed(0));
+      EXPECT_NEAR(centreHeight(sim), 0.1, 1e-12);
+      EXPECT_LT(sim.v().norm(), 1e-10);
+      EXPECT_NEAR(sim.lambda()[2], 0.5 * kG, 1e-9) << "at rest the normal force carries the weight";
+    }
+  }
+}
+
+// Protects: the rolling impact. With the no-slip rows closed by the impact,
+// the impulse acts at the contact point P, so the angular momentum about P
+// is conserved: (I + m r²) ω'ₕ = I ωₕ + m r e_z × vₕ, ω'_z = ω_z.
+TEST(ContactEvents, PlasticRollingImpactConservesAngularMomentumAboutTheContactPoint) {
+  const double m = 0.5, r = 0.1, I = 0.4 * m * r * r;
+  const Vec3 omega(1.5, -4.0, 2.0), vG(0.7, 0.2, 0.0);
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    BuiltScene s = raisedBall(0.05, omega, vG, 0.0);
+    Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                  IntegratorType::DormandPrince54, tight());
+    ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+    const auto events = runCollecting(sim, 0.2, 1e-2);
+    ASSERT_GE(events.size(), 1u);
+    ASSERT_EQ(events[0].kind, ContactEventKind::Touchdown);
+    // Flight: ω and the horizontal velocity are constant; the impact's
+    // horizontal effect follows from L_P.
+    const Vec3 Lh = I * Vec3(omega.x(), omega.y(), 0) + m * r * Vec3::UnitZ().cross(vG);
+    const Vec3 w_after(Lh.x() / (I + m * r * r), Lh.y() / (I + m * r * r), omega.z());
+    const Vec3 v_after = r * w_after.cross(Vec3::UnitZ());
+    // After the impact the ball rolls on a fixed plane: ω and v_G constant.
+    const Mat3 R = floatingRotation(sim.q(), 0);
+    const Vec3 w_now = R * Vec3(sim.v().head<3>()), v_now = R * Vec3(sim.v().tail<3>());
+    EXPECT_LT((w_now - w_after).norm(), 1e-9) << toString(f);
+    EXPECT_LT((v_now - v_after).norm(), 1e-9) << toString(f);
+  }
+}
+
+// Protects: Newton restitution and the end of a bouncing sequence. Impact
+// speeds fall as eᵏ√(2gh), impacts happen at t₁ = √(2h/g),
+// t_{k+1} = t_k + 2eᵏ√(2h/g), flights conserve energy, and below rest_speed
+// the contact closes plastically: finitely many events, the ball at rest.
+TEST(ContactEvents, BouncingBallApexesDecayAsRestitutionSquaredAndTheSequenceEnds) {
+  const double h = 0.3, e = 0.5;
+  const double v1 = std::sqrt(2 * kG * h);
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
+    BuiltScene s = raisedBall(h, Vec3::Zero(), Vec3::Zero(), e);
+    SimulatorOptions so;
+    so.contacts.rest_speed = 0.05;
+    Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                  IntegratorType::DormandPrince54, tight(), so);
+    ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+    const double E_rest = 0.5 * kG * 0.1;  // m g r: resting on the plane
+    const double E0 = sim.energy() - E_rest;
+    std::vector<ContactEvent> events;
+    double apex = 0;
+    std::vector<double> apexes;
+    while (sim.time() < 3.0) {
+      const StepStatus st = sim.step(2e-3);
+      ASSERT_TRUE(st.ok) << st.message;
+      apex = std::max(apex, centreHeight(sim) - 0.1);
+      for (const auto& ev : sim.events()) {
+        if (!events.empty()) apexes.push_back(apex);
+        apex = 0;
+        events.push_back(ev);
+      }
+      if (!sim.isClosed(0) && events.size() < 3)
+        EXPECT_NEAR(sim.energy() - E_rest, E0 * std::pow(e * e, events.size()), 1e-9 * E0);
+    }
+    // Bounces while eᵏ v₁ ≥ rest_speed, then one plastic touchdown.
+    int bounces = 0;
+    while (std::pow(e, bounces) * v1 >= so.contacts.rest_speed) ++bounces;
+    ASSERT_EQ(static_cast<int>(events.size()), bounces + 1) << toString(f);
+    double t = std::sqrt(2 * h / kG);
+    for (int k = 0; k < bounces; ++k) {
+      EXPECT_EQ(events[k].kind, ContactEventKind::Bounce);
+      EXPECT_NEAR(events[k].t, t, 1e-9) << "impact " << k;
+      EXPECT_NEAR(-events[k].speed_before, std::pow(e, k) * v1, 1e-8) << "impact " << k;
+      EXPECT_NEAR(events[k].speed_after, std::pow(e, k + 1) * v1, 1e-8) << "impact " << k;
+      t += 2 * std::pow(e, k + 1) * v1 / kG;
+    }
+    EXPECT_EQ(events.back().kind, ContactEventKind::Touchdown);
+    for (int k = 0; k + 1 < static_cast<int>(apexes.size()) && k < 3; ++k)
+      EXPECT_NEAR(apexes[k], h * std::pow(e, 2 * (k + 1)), 2e-3 * h) << "apex " << k;
+    EXPECT_TRUE(sim.isClosed(0));
+    EXPECT_LT(sim.v().norm(), 1e-10);
+  }
+}
+
+// Protects: lift-off located where λₙ crosses zero. A resting ball pulled up
+// by F(t) = k t leaves the plane at t* = m g / k, then rises as
+// z − r = k (t − t*)³ / (6 m).
+TEST(ContactEvents, BallPulledUpLiftsOffWhenTheNormalForceVanishes) {
+  const double m = 0.5, k = 2.0;
+  const double t_star = m * kG / k;
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    for (IntegratorType it : {IntegratorType::DormandPrince54, IntegratorType::RK4}) {
+      BuiltScene s = raisedBall(0.0, Vec3(0, 3.0, 0), Vec3(0.3, 0, 0), 0.0);
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, tight());
+      sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
+        tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(0, 0, k * t);
+      });
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+      EXPECT_TRUE(sim.isClosed(0));
+      const auto events = runCollecting(sim, t_star + 0.5, 1e-2);
+      ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it);
+      EXPECT_EQ(events[0].kind, ContactEventKind::LiftOff);
+      EXPECT_NEAR(events[0].t, t_star, 1e-10) << toString(f) << " " << toString(it);
+      EXPECT_FALSE(sim.isClosed(0));
+      EXPECT_NEAR(centreHeight(sim) - 0.1, k * std::pow(0.5, 3) / (6 * m), 1e-9);
+    }
+  }
+}
