@@ -79,8 +79,30 @@ void printContacts(std::ostream& out, const RunSummary& r) {
     if (e.pulling)
       out << "  ⚠ normal pulls in " << e.pulling << " samples from t=" << e.first_pull
           << ": would lift off";
+    if (e.open_samples) out << "; open in " << e.open_samples << " samples";
     out << "\n";
   }
+}
+
+// One line per contact event (at most the first 50, then a count).
+void printEvents(std::ostream& out, const RunSummary& r) {
+  if (r.events.empty()) return;
+  out << "contact events (" << r.events.size() << "; impacts took " << std::setprecision(6)
+      << r.impact_energy_loss << " J):\n";
+  const std::size_t shown = std::min<std::size_t>(r.events.size(), 50);
+  for (std::size_t k = 0; k < shown; ++k) {
+    const RunEvent& e = r.events[k];
+    out << "  t = " << std::setprecision(12) << std::left << std::setw(16) << e.t << std::right
+        << std::setprecision(6) << std::setw(10) << toString(e.kind) << "  " << e.contact;
+    if (e.kind != ContactEventKind::LiftOff && e.speed_before < 0)
+      out << "  normal speed " << e.speed_before << " → " << e.speed_after << " m/s, impulse "
+          << e.normal_impulse << " N·s";
+    if (e.outside_friction_cone)
+      out << "  ⚠ tangential impulse " << e.tangential_impulse
+          << " outside the friction cone: would slip";
+    out << "\n";
+  }
+  if (shown < r.events.size()) out << "  … " << r.events.size() - shown << " more\n";
 }
 
 void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
@@ -97,7 +119,8 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
   out << ", " << c.evaluations << " dynamics solves\n"
       << "wall time    " << r.wall_seconds << " s, "
       << 1e6 * r.wall_seconds / std::max<long>(1, c.steps) << " µs per step\n"
-      << "energy       E0 = " << r.energy0 << " J, max |E − E0| = " << r.max_energy_deviation
+      << "energy       E0 = " << r.energy0 << " J, max |E "
+      << (r.events.empty() ? "" : "+ impact losses ") << "− E0| = " << r.max_energy_deviation
       << " J (" << r.relativeEnergyDeviation() << " relative)"
       << (r.passive ? "" : "  [driven scene: energy is not conserved]") << "\n"
       << "residuals    max |Av+b| = " << r.max_velocity_residual
@@ -110,6 +133,10 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
     out << r.partition_changes << " re-choices of the velocity partition; ";
     ++events;
   }
+  if (!r.events.empty()) {
+    out << r.events.size() << " contact events (below); ";
+    ++events;
+  }
   if (r.flaggedContacts()) {
     out << r.flaggedContacts() << " contacts flagged (below); ";
     ++events;
@@ -119,6 +146,7 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
     ++events;
   }
   out << (events ? "\n" : "none\n");
+  printEvents(out, r);
   printContacts(out, r);
 }
 

@@ -135,8 +135,9 @@ TEST(ContactEvents, BouncingBallApexesDecayAsRestitutionSquaredAndTheSequenceEnd
         apex = 0;
         events.push_back(ev);
       }
-      if (!sim.isClosed(0) && events.size() < 3)
+      if (!sim.isClosed(0) && events.size() < 3) {
         EXPECT_NEAR(sim.energy() - E_rest, E0 * std::pow(e * e, events.size()), 1e-9 * E0);
+      }
     }
     // Bounces while eᵏ v₁ ≥ rest_speed, then one plastic touchdown.
     int bounces = 0;

@@ -50,7 +50,8 @@ TEST(IoOutput, ColumnsNameEveryJointCoordinateAndContactRow) {
       "energy", "residual",
       "point:ball_table.x", "point:ball_table.y", "point:ball_table.z",
       "normal:ball_table.x", "normal:ball_table.y", "normal:ball_table.z",
-      "lambda:ball_table.tangent1", "lambda:ball_table.tangent2", "lambda:ball_table.normal"};
+      "lambda:ball_table.tangent1", "lambda:ball_table.tangent2", "lambda:ball_table.normal",
+      "closed:ball_table", "event:ball_table"};  // a unilateral contact's mode and events
   EXPECT_EQ(cols, expected);
 
   const Model m = loadUrdfModel(kData + "all_joints.urdf");

@@ -164,8 +164,8 @@ TEST(IoScene, ShapesFromCollisionGeometryAndExplicit) {
 }
 
 TEST(IoScene, ProjectionOfASlidingBallGivesFiveSevenths) {
-  // The ball starts 0.4 m above the plane, sliding at 1 m/s without spin.
-  // Projection puts it on the plane and, in the mass metric, onto rolling:
+  // The ball touches the plane, sliding at 1 m/s without spin. Projection
+  // puts it, in the mass metric, onto rolling:
   // min m|v − v₀|² + I ω² subject to v = r ω gives v = v₀ m r² /(m r² + I)
   // = 5/7 for a homogeneous ball — the classic result (the impulse at the
   // contact conserves angular momentum about the contact point).

@@ -51,6 +51,10 @@ std::vector<std::string> trajectoryColumns(const Model& model, const ConstraintL
     for (const char* xyz : {".x", ".y", ".z"}) cols.push_back("normal:" + con->name() + xyz);
     for (int k = 0; k < con->rows(); ++k)
       cols.push_back("lambda:" + con->name() + "." + con->rowLabel(k));
+    if (con->unilateral()) {
+      cols.push_back("closed:" + con->name());
+      cols.push_back("event:" + con->name());
+    }
   }
   return cols;
 }
@@ -68,6 +72,7 @@ TrajectoryWriter::TrajectoryWriter(std::ostream& out, const Model& model,
       columns_(trajectoryColumns(model, constraints)) {
   for (const auto& c : constraints) {
     rows_.push_back(c->rows());
+    unilateral_.push_back(c->unilateral() ? 1 : 0);
     nrows_ += c->rows();
   }
   std::string header;
@@ -86,7 +91,11 @@ void TrajectoryWriter::put(double x) {
 
 void TrajectoryWriter::write(double t, const VecX& q, const VecX& v, double energy,
                              double residual, const std::vector<ContactFrame>& frames,
-                             const VecX& lambda) {
+                             const VecX& lambda, const std::vector<ContactState>& states) {
+  if (!states.empty() && static_cast<int>(states.size()) != nconstraints_)
+    throw std::invalid_argument("TrajectoryWriter::write: " + std::to_string(states.size()) +
+                                " contact states for " + std::to_string(nconstraints_) +
+                                " constraints");
   if (q.size() != nq_ || v.size() != nv_ || static_cast<int>(frames.size()) != nconstraints_ ||
       lambda.size() != nrows_)
     throw std::invalid_argument(
@@ -105,6 +114,10 @@ void TrajectoryWriter::write(double t, const VecX& q, const VecX& v, double ener
     for (int k = 0; k < 3; ++k) put(frames[c].point(k));
     for (int k = 0; k < 3; ++k) put(frames[c].normal(k));
     for (int k = 0; k < rows_[c]; ++k) put(lambda(row++));
+    if (unilateral_[c]) {
+      put(states.empty() || states[c].closed ? 1.0 : 0.0);
+      put(states.empty() ? 0.0 : static_cast<double>(states[c].event));
+    }
   }
   line_ += '\n';
   out_ << line_;

@@ -30,16 +30,21 @@ std::vector<ContactStats> contactStats(const Scene& scene) {
   return stats;
 }
 
-void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda) {
+void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
+            const ConstraintData& cdata) {
   for (ContactStats& e : stats) {
     if (e.normal_row < 0) continue;
+    if (!cdata.isActive(cdata.row_constraint[e.normal_row])) {
+      ++e.open_samples;
+      continue;
+    }
     const double fn = lambda[e.normal_row];
     double ft2 = 0;
     for (int r : e.tangential_rows) ft2 += lambda[r] * lambda[r];
     const double ft = std::sqrt(ft2);
     e.min_normal = std::min(e.min_normal, fn);
     e.max_normal = std::max(e.max_normal, fn);
-    if (fn <= 0) {
+    if (fn <= 0) {  // a bilateral contact pulling, or a unilateral one at lift-off
       if (e.pulling++ == 0) e.first_pull = t;
       continue;
     }

@@ -9,7 +9,9 @@ namespace appell::run_detail {
 /// kind (RowKind), μ is the scene's (index-aligned contacts).
 std::vector<ContactStats> contactStats(const Scene& scene);
 
-/// Adds the sample (t, λ) to every entry. No allocation.
-void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda);
+/// Adds the sample (t, λ) to every entry; open contacts (`cdata`'s active
+/// set) count as open samples. No allocation.
+void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
+            const ConstraintData& cdata);
 
 }  // namespace appell::run_detail

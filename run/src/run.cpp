@@ -85,14 +85,39 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.max_velocity_residual = sim.velocityResidual();
   s.max_gap_residual = sim.gapResidual();
   s.max_redundant = sim.redundantRows();
-  run_detail::sample(s.contacts, sim.time(), sim.lambda());
+  run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
   s.samples = 1;
+  if (!sim.lastStateError().empty()) {
+    s.ok = false;
+    s.failure = sim.lastStateError();
+    s.time = sim.time();
+    s.counters = sim.counters();
+    if (on_sample) on_sample(sim);
+    return s;
+  }
+  auto record = [&](const Simulator& sm) {
+    for (const ContactEvent& ev : sm.events()) {
+      RunEvent r;
+      r.t = ev.t;
+      r.contact = scene.constraints[ev.constraint]->name();
+      r.kind = ev.kind;
+      r.speed_before = ev.speed_before;
+      r.speed_after = ev.speed_after;
+      r.normal_impulse = ev.normal_impulse;
+      r.tangential_impulse = ev.tangential_impulse;
+      r.outside_friction_cone =
+          ev.tangential_impulse > s.contacts[ev.constraint].mu * ev.normal_impulse * (1 + 1e-9);
+      s.events.push_back(std::move(r));
+    }
+  };
+  record(sim);
   if (on_sample) on_sample(sim);
 
   const auto wall0 = std::chrono::steady_clock::now();
   const bool adaptive = options.integrator == IntegratorType::DormandPrince54;
   double h = options.dt;
   long step = 0;
+  bool last_sampled = true;
   while (sim.time() < options.duration * (1 - 1e-12)) {
     const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
     if (!status.ok) {
@@ -102,19 +127,25 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     }
     ++step;
     if (adaptive) h = status.h_next;
-    s.max_energy_deviation = std::max(s.max_energy_deviation, std::abs(sim.energy() - s.energy0));
+    record(sim);
+    s.max_energy_deviation = std::max(
+        s.max_energy_deviation, std::abs(sim.energy() + sim.impactEnergyLoss() - s.energy0));
     s.max_velocity_residual = std::max(s.max_velocity_residual, sim.velocityResidual());
     s.max_gap_residual = std::max(s.max_gap_residual, sim.gapResidual());
     s.max_redundant = std::max(s.max_redundant, sim.redundantRows());
-    run_detail::sample(s.contacts, sim.time(), sim.lambda());
+    run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
     ++s.samples;
-    if (on_sample && step % options.output_every == 0) on_sample(sim);
+    // A step that ends at an event is always a sample: each event is a row.
+    const bool sampled = step % options.output_every == 0 || !sim.events().empty();
+    if (on_sample && sampled) on_sample(sim);
+    last_sampled = sampled;
     if (on_step) on_step(sim);
   }
   s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   // The last state reached is always sampled (the failure leaves the last good one).
-  if (on_sample && step % options.output_every != 0) on_sample(sim);
+  if (on_sample && !last_sampled) on_sample(sim);
   s.time = sim.time();
+  s.impact_energy_loss = sim.impactEnergyLoss();
   s.counters = sim.counters();
   s.partition_changes = sim.partitionChanges();
   return s;
@@ -123,10 +154,16 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
 RunSummary runScene(const Scene& scene, const RunOptions& options, TrajectoryWriter& writer,
                     const RunObserver& on_step) {
   std::vector<ContactFrame> frames(scene.constraints.size());
+  std::vector<ContactState> states(scene.constraints.size());
   auto write = [&](const Simulator& sim) {
-    for (std::size_t k = 0; k < frames.size(); ++k) frames[k] = sim.contactFrame(static_cast<int>(k));
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      frames[k] = sim.contactFrame(static_cast<int>(k));
+      states[k] = {sim.isClosed(static_cast<int>(k)), 0};
+    }
+    for (const ContactEvent& ev : sim.events())
+      if (ev.t == sim.time()) states[ev.constraint].event = 1 + static_cast<int>(ev.kind);
     writer.write(sim.time(), sim.q(), sim.v(), sim.energy(),
-                 std::max(sim.velocityResidual(), sim.gapResidual()), frames, sim.lambda());
+                 std::max(sim.velocityResidual(), sim.gapResidual()), frames, sim.lambda(), states);
   };
   return runScene(scene, options, write, on_step);
 }

@@ -116,6 +116,10 @@ class Simulator {
   /// Contact events of the last step() / setState(), in time order (the
   /// buffer is reused: copy what you keep).
   const std::vector<ContactEvent>& events() const { return events_; }
+  /// Kinetic energy taken by the impacts since setState() (J, ≥ 0 up to
+  /// round-off; an impact at setState() itself is not counted):
+  /// E + impactEnergyLoss() is conserved by a passive scene.
+  double impactEnergyLoss() const { return dissipated_; }
   /// Whether unilateral constraint `c` is closed now.
   bool isClosed(int constraint) const { return cdata_->isActive(constraint); }
   const SimulatorCounters& counters() const { return counters_; }
@@ -166,6 +170,7 @@ class Simulator {
   std::unique_ptr<detail::UnilateralState> uni_;  // sized once: contact_events.cpp
   std::vector<ContactEvent> events_;
   std::string state_error_;
+  double dissipated_ = 0;
 };
 
 }  // namespace appell

@@ -1,6 +1,7 @@
 // Unilateral constraints in the simulator: event detection and location, and
 // the mode decision at an event (impact, then contact forces). The
 // mathematics and the references are in contact_events.hpp.
+#include <appell/dynamics.hpp>
 #include <appell/kinematics.hpp>
 #include <appell/simulator.hpp>
 
@@ -198,8 +199,10 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
     if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
   }
+  const double T_before = appell::kineticEnergy(model_, *data_, q_, v_);
   if (!decideModes(error)) return fail(st, "at t = " + std::to_string(t_) + ": " + error);
   if (!projectAfterModes(error)) return fail(st, error);
+  dissipated_ += T_before - appell::kineticEnergy(model_, *data_, q_, v_);
   integrator_->reset();
   if (!evaluateEndState(error)) return fail(st, error);
   st.events = static_cast<int>(events_.size());

@@ -58,6 +58,7 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   h_suggest_ = 0;
   events_.clear();
   state_error_.clear();
+  dissipated_ = 0;
   if (uni_ && options_.contacts.enabled) {
     // A new state: unilateral constraints with clearance start open, the
     // touching ones get their modes decided (impact, then forces).

@@ -132,7 +132,8 @@ class XmlShapeParameters : public ShapeParameters {
 std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement* e) {
   const bool has_shape = has(e, "shape"), has_point = has(e, "point");
   if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
-  static const char* const kCommon[] = {"name", "link", "kind", "support", "mu", "direction"};
+  static const char* const kCommon[] = {"name",      "link",        "kind",      "support",
+                                        "mu",        "direction",   "restitution", "unilateral"};
   auto allow = [&](const std::vector<const char*>& extra) {
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string n = a->Name();
@@ -194,6 +195,18 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
   if (has(e, "mu")) {
     d.spec.mu = number(src, e, "mu");
     if (d.spec.mu < 0) fail(src, e, "friction coefficient 'mu' must not be negative");
+  }
+  if (has(e, "restitution")) {
+    d.spec.restitution = number(src, e, "restitution");
+    if (!(d.spec.restitution >= 0 && d.spec.restitution <= 1))
+      fail(src, e, "restitution must lie in [0, 1] (0: plastic, 1: elastic)");
+  }
+  if (has(e, "unilateral")) {
+    const std::string u = text(src, e, "unilateral");
+    if (u != "true" && u != "false")
+      fail(src, e, "'unilateral' must be \"true\" (the contact can lift off, the default) or "
+                   "\"false\" (it always holds)");
+    d.spec.unilateral = u == "true";
   }
   if (d.spec.kind == ContactKind::KnifeEdge && shape && shapeType(*shape).role == ShapeRole::Point &&
       !has_direction)

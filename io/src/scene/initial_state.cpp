@@ -23,6 +23,7 @@ Worst worstRow(const ConstraintData& cd, const VecX& v) {
   Worst w;
   const VecX r = cd.A * v + cd.b;
   for (int i = 0; i < cd.m; ++i) {
+    if (!cd.isActive(cd.row_constraint[i])) continue;  // open: its gap is a clearance
     if (std::abs(cd.gap(i)) > w.value) w = {std::abs(cd.gap(i)), i, true};
     if (std::abs(r(i)) > w.value) w = {std::abs(r(i)), i, false};
   }
@@ -61,6 +62,22 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
 
   Data data(model);
   ConstraintData cd(model, scene.constraints);
+  evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
+  // Contacts with clearance start open (as the simulator opens them): only
+  // the closed ones must hold. A unilateral gap below −tol is penetration.
+  for (int c = 0; c < static_cast<int>(scene.constraints.size()); ++c) {
+    const Constraint& con = *scene.constraints[c];
+    if (!con.unilateral()) continue;
+    const double g = cd.gap[cd.offset[c] + con.unilateralRow()];
+    if (g > tol) cd.setActive(c, false);
+    if (g < -tol && !project) {
+      std::ostringstream s;
+      s << scene.source << ": initial state: contact '" << con.name()
+        << "' penetrates its support by " << -g << " (gap " << g << ", tolerance " << tol
+        << "); raise the body, or load with project_initial_state to push it out";
+      throw SceneError(s.str());
+    }
+  }
   evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
   if (cd.singular) singular(scene, cd);
   report.velocity_residual = velocityResidual(data, scene.constraints, cd, scene.v0);

@@ -14,8 +14,13 @@
 //   contacts    per constraint, from its rows' kinds (constraint.hpp): the
 //               normal load f_n = λ_normal, the friction demand |f_t| / f_n
 //               with f_t the λ of the tangent and lateral rows, against the
-//               scene's μ, and the samples where the normal pulls (f_n ≤ 0:
-//               a unilateral contact would lift off);
+//               scene's μ, and the samples where a closed contact's normal
+//               pulls (f_n < 0: only a bilateral contact can pull; a
+//               unilateral one lifts off at f_n = 0);
+//   events      every touchdown, bounce and lift-off (contact_events.hpp)
+//               with its time, speeds and impulses; an impulse outside the
+//               friction cone is flagged; the energy balance counts the
+//               kinetic energy the impacts took;
 //   failure     the first step that fails stops the run; the summary keeps
 //               its reason and the time of the last good state.
 // The observer sees the state at t = 0, after every `output_every`-th step
@@ -64,6 +69,18 @@ struct ContactStats {
   double first_pull = -1, first_slip = -1;  ///< when they first happened (−1: never)
   /// The friction demand exceeded μ or the normal pulled.
   bool flagged() const { return pulling > 0 || over_mu > 0; }
+  long open_samples = 0;           ///< samples with the contact open (in flight)
+};
+
+/// A contact event of the run (Simulator::events()), named.
+struct RunEvent {
+  double t = 0;
+  std::string contact;
+  ContactEventKind kind = ContactEventKind::Touchdown;
+  double speed_before = 0, speed_after = 0;  ///< normal velocity (negative: approaching)
+  double normal_impulse = 0, tangential_impulse = 0;
+  /// The impulse left the friction cone (|Λ_t| > μ Λ_n): a real contact would slip.
+  bool outside_friction_cone = false;
 };
 
 struct RunSummary {
@@ -76,7 +93,9 @@ struct RunSummary {
   double wall_seconds = 0;         ///< wall time of the stepping loop
   bool passive = true;             ///< no joint forces, no moving support: E is conserved
   double energy0 = 0;              ///< E at t = 0 (J)
-  double max_energy_deviation = 0; ///< max |E − E₀| (J)
+  double max_energy_deviation = 0; ///< max |E + impact losses − E₀| (J)
+  double impact_energy_loss = 0;   ///< kinetic energy taken by impacts (J)
+  std::vector<RunEvent> events;    ///< contact events, in time order
   double energy_scale = 0;         ///< max(|E₀|, T₀, 1e-12)
   double max_velocity_residual = 0;  ///< max ‖A v + b‖∞, t = 0 included
   double max_gap_residual = 0;       ///< max |g|, t = 0 included
