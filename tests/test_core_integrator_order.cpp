@@ -251,3 +251,40 @@ TEST(IntegratorOrder, SymplecticEulerEnergyErrorIsBoundedAndFirstOrder) {
     EXPECT_LT(p, 1.3);
   }
 }
+
+// Protects the dense output event location relies on (contact_events.hpp):
+// Dormand–Prince's continuous extension reproduces the step's ends exactly
+// and is accurate to O(h⁵) locally inside the step (order 4), also on SO(3).
+TEST(IntegratorOrder, DormandPrinceDenseOutputIsFourthOrderInsideTheStep) {
+  for (const Scene& sc : scenes()) {
+    const Model& model = sc.model;
+    std::vector<double> errors;
+    for (double h : {0.1, 0.05, 0.025}) {
+      AbaField f(model);
+      IntegratorOptions opt;
+      opt.rtol = opt.atol = 1e30;  // accept h as given
+      opt.h_max = h;
+      auto integ = makeIntegrator(IntegratorType::DormandPrince54, model, opt);
+      State s = sc.s0;
+      double t = 0;
+      ASSERT_TRUE(integ->step(f, t, s.q, s.v, h).ok);
+      State d{VecX(model.nq), VecX(model.nv)};
+      ASSERT_TRUE(integ->denseOutput(1.0, d.q, d.v));
+      EXPECT_LT(globalError(model, d, s), 1e-14) << sc.name << ": s = 1 is the step's end";
+      ASSERT_TRUE(integ->denseOutput(0.0, d.q, d.v));
+      EXPECT_LT(globalError(model, d, sc.s0), 1e-14) << sc.name << ": s = 0 is its start";
+      double worst = 0;
+      for (double sfrac : {0.2, 0.5, 0.8}) {
+        ASSERT_TRUE(integ->denseOutput(sfrac, d.q, d.v));
+        worst = std::max(worst, globalError(model, d, reference(model, sc.s0, sfrac * h)));
+      }
+      errors.push_back(worst);
+    }
+    for (double p : orders(errors)) EXPECT_GT(p, 4.5) << sc.name << ": local order 5 (interpolant of order 4)";
+  }
+  Model m = doublePendulum();
+  AbaField f(m);
+  auto integ = makeIntegrator(IntegratorType::RK4, m);
+  VecX q(2), v(2);
+  EXPECT_FALSE(integ->denseOutput(0.5, q, v)) << "RK4 has no dense output: events shorten its step";
+}

@@ -5,8 +5,9 @@
 //   SymplecticEuler  v⁺ = v + h f(q, v),  q⁺ = retract(q, h v⁺)     order 1
 //   RK4              classic 4-stage Runge–Kutta–Munthe-Kaas       order 4
 //   DormandPrince54  embedded 5(4) pair, FSAL, error control on (θ, v)
-//                    with rtol/atol and the usual PI-free step controller
-//                    (Hairer, Nørsett, Wanner I, §II.4–5)              order 5
+//                    with rtol/atol and the usual PI-free step controller,
+//                    and Dormand & Prince's 4th-order continuous extension
+//                    as dense output (Hairer, Nørsett, Wanner I, §II.4–6) order 5
 // Work vectors are allocated at construction; step() does not allocate.
 #pragma once
 
@@ -64,6 +65,13 @@ class Integrator {
   /// Forget any state carried between steps (the FSAL stage); call after the
   /// caller changes q or v itself (projection, an impulse).
   virtual void reset() {}
+  /// Dense output of the last accepted step: the state at t₀ + s·h, s ∈ [0, 1]
+  /// (a continuous extension of the method's own stages, no new evaluation).
+  /// Returns false when the method has none or no step was accepted since.
+  virtual bool denseOutput(double s, VecX& q, VecX& v) {
+    (void)s, (void)q, (void)v;
+    return false;
+  }
 };
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type, const Model& model,

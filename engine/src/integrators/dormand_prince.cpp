@@ -23,18 +23,26 @@ constexpr double A[7][6] = {
 // Difference between the 5th-order weights (row 7 of A) and the embedded 4th-order ones.
 constexpr double E[7] = {71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200,
                          22.0 / 525, -1.0 / 40};
+// The continuous extension's fifth coefficient (Hairer, Nørsett, Wanner I,
+// §II.6; Shampine 1986): y(t₀ + s h) = y₀ + s(Δ + (1 − s)(r₃ + s(r₄ + (1 − s) r₅)))
+// with Δ = y₁ − y₀, r₃ = h k₁ − Δ, r₄ = Δ − h k₇ − r₃, r₅ = h Σ D_i k_i.
+constexpr double D[7] = {-12715105075.0 / 11282082432.0, 0, 87487479700.0 / 32700410799.0,
+                         -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
+                         -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0};
 
 }  // namespace
 
 DormandPrince54::DormandPrince54(const Model& model, const IntegratorOptions& options)
     : model_(model), opt_(options), theta_(model.nv), vs_(model.nv), qs_(model.nq),
-      err_th_(model.nv), err_v_(model.nv), scale_q_(model.nv) {
+      err_th_(model.nv), err_v_(model.nv), scale_q_(model.nv), q_start_(model.nq),
+      v_start_(model.nv), dth_(model.nv), dv_(model.nv) {
   for (auto& k : kth_) k.resize(model.nv);
   for (auto& k : kv_) k.resize(model.nv);
 }
 
 StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) {
   StepResult r;
+  dense_ = false;
   h = std::min(h, opt_.h_max);
   // Magnitudes the local coordinates are measured against: the coordinate itself
   // for Euclidean joints, 1 rad for rotations.
@@ -87,10 +95,16 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
       err = model_.nv > 0 ? std::sqrt(sum / (2.0 * model_.nv)) : 0.0;
     }
     if (field_ok && err <= 1.0) {
+      q_start_ = q;  // kept for the dense output
+      v_start_ = v;
+      h_last_ = h;
+      dense_ = true;
       q = qs_;
       v = vs_;
       t += h;
-      kv_[0] = kv_[6];  // FSAL: the last stage is the next step's first
+      // FSAL: the last stage is the next step's first. Swapped, not copied:
+      // kv_[6] keeps this step's k₁ for the dense output (kv_[0] is its k₇).
+      std::swap(kv_[0], kv_[6]);
       have_fsal_ = true;
       r.h_taken = h;
       r.error = err;
@@ -107,6 +121,33 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
       return r;
     }
   }
+}
+
+bool DormandPrince54::denseOutput(double s, VecX& q, VecX& v) {
+  if (!dense_) return false;
+  const double h = h_last_;
+  // Local coordinates θ about q₀ (θ₁ = theta_), and v; k₁ of θ is kth_[0],
+  // k₇ kth_[6]; k₁ of v is kv_[6] and k₇ kv_[0] after the FSAL swap.
+  auto interpolate = [&](const VecX& y1, const VecX& k1, const VecX& k7, const VecX* const* k,
+                         const VecX& y0, VecX& out, VecX& r5) {
+    r5.setZero();
+    for (int i = 0; i < 7; ++i)
+      if (D[i] != 0) r5 += (h * D[i]) * *k[i];
+    for (int j = 0; j < y1.size(); ++j) {
+      const double delta = y1[j] - y0[j];
+      const double r3 = h * k1[j] - delta;
+      const double r4 = delta - h * k7[j] - r3;
+      out[j] = y0[j] + s * (delta + (1 - s) * (r3 + s * (r4 + (1 - s) * r5[j])));
+    }
+  };
+  const VecX* kth[7] = {&kth_[0], &kth_[1], &kth_[2], &kth_[3], &kth_[4], &kth_[5], &kth_[6]};
+  const VecX* kv[7] = {&kv_[6], &kv_[1], &kv_[2], &kv_[3], &kv_[4], &kv_[5], &kv_[0]};
+  err_th_.setZero();  // θ₀ = 0
+  interpolate(theta_, kth_[0], kth_[6], kth, err_th_, dth_, err_v_);
+  interpolate(vs_, kv_[6], kv_[0], kv, v_start_, dv_, err_v_);
+  v = dv_;
+  retract(model_, q_start_, dth_, q);
+  return true;
 }
 
 }  // namespace appell::detail

@@ -38,13 +38,17 @@ class DormandPrince54 final : public Integrator {
   bool adaptive() const override { return true; }
   StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) override;
   void reset() override { have_fsal_ = false; }
+  bool denseOutput(double s, VecX& q, VecX& v) override;
 
  private:
   const Model& model_;
   IntegratorOptions opt_;
   std::array<VecX, 7> kth_, kv_;
   VecX theta_, vs_, qs_, err_th_, err_v_, scale_q_;
+  VecX q_start_, v_start_, dth_, dv_;  // the last accepted step, for dense output
+  double h_last_ = 0;
   bool have_fsal_ = false;
+  bool dense_ = false;                 // the last call accepted a step: dense output valid
 };
 
 }  // namespace appell::detail

@@ -122,12 +122,27 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
   u.v0 = v_prev_;
   int k = crossedConstraint();
   double hi = h;
+  // The event functions along the step: on the integrator's dense output
+  // when it has one (Dormand–Prince: no new evaluations), else on steps from
+  // the start shortened to τ. The step to the located event is always a
+  // proper step of the method.
+  const bool dense = integrator_->denseOutput(1.0, q_, v_);
+  auto stateAt = [&](double tau) {
+    if (!dense) return restepTo(tau, st);
+    t_ = u.t0 + tau;
+    if (tau <= 0) {
+      q_ = u.q0;
+      v_ = u.v0;
+      return true;
+    }
+    return integrator_->denseOutput(tau / h, q_, v_);
+  };
   for (int round = 0; k >= 0 && round < static_cast<int>(u.rows.size()) + 1; ++round) {
     // Illinois (modified regula falsi) on φ_k(τ) over [0, hi]: φ(0) ≥ 0 > φ(hi).
     double a = 0, b = hi;
-    if (!restepTo(a, st)) return fail(st, "event location: the step from the last state failed");
+    if (!stateAt(a)) return fail(st, "event location: the step from the last state failed");
     double fa = eventFunction(k);
-    if (!restepTo(b, st)) return fail(st, "event location: the step from the last state failed");
+    if (!stateAt(b)) return fail(st, "event location: the step from the last state failed");
     b = t_ - u.t0;
     double fb = eventFunction(k);
     if (!std::isfinite(fa) || !std::isfinite(fb))
@@ -140,7 +155,7 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
       for (int it = 0; it < o.max_locate_iterations && b - a > o.time_tol; ++it) {
         double c = (a * fb - b * fa) / (fb - fa);
         if (!(c > a && c < b)) c = 0.5 * (a + b);
-        if (!restepTo(c, st)) return fail(st, "event location: a shortened step failed");
+        if (!stateAt(c)) return fail(st, "event location: a shortened step failed");
         c = t_ - u.t0;  // an adaptive method may have taken less than asked
         const double fc = eventFunction(k);
         if (!std::isfinite(fc)) return fail(st, "event location: non-finite event function");
@@ -159,7 +174,7 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
       }
     }
     // Did another contact cross before τ = b? Then that one is first.
-    if (!restepTo(b, st)) return fail(st, "event location: a shortened step failed");
+    if (!stateAt(b)) return fail(st, "event location: a shortened step failed");
     hi = t_ - u.t0;
     evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     int earlier = -1;
@@ -177,6 +192,8 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     if (earlier < 0) break;
     k = earlier;
   }
+  if (dense && !restepTo(hi, st))  // the step itself, to the event
+    return fail(st, "event location: the step to the event failed");
   if (hi <= 0) {
     if (++u.zero_events > 2)
       return fail(st, "contact '" + constraints_[u.rows[k].c]->name() +
