@@ -218,3 +218,52 @@ TEST(ContactEvents, TreeAndKktAgreeAtEveryActiveSetOfTheCar) {
   }
   EXPECT_EQ(cd.m_active, cd.m);
 }
+
+// Protects: contacts that change together are decided together. Each step of
+// the rimless wheel (examples/rimless_wheel) lands a pair of feet while the
+// trailing pair lifts off in the same impact problem; angular momentum about
+// the new contact line is conserved, so with G − Pᵢ = (±l sin α, l cos α + ρ)
+// in the plane of the wheel,
+//     ω⁺/ω⁻ = (I + m (G−P₂)·(G−P₁)) / (I + m |G−P₂|²),
+// and the kinetic energy of the rolling stance drops by that ratio squared.
+TEST(ContactEvents, RimlessWheelLandsAndLiftsFeetPairwiseWithTheImpactLaw) {
+  Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/rimless_wheel/rimless_wheel.urdf");
+  const double m = 2, I = 0.1, l = 0.4, rho = 0.02, alpha = M_PI / 8;
+  const double d12 = -std::pow(l * std::sin(alpha), 2) + std::pow(l * std::cos(alpha) + rho, 2);
+  const double d22 = std::pow(l * std::sin(alpha), 2) + std::pow(l * std::cos(alpha) + rho, 2);
+  const double ratio = (I + m * d12) / (I + m * d22);
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
+    Simulator sim(scene.model, scene.constraints, makeSolver(f, scene.model, scene.constraints),
+                  IntegratorType::DormandPrince54, tight());
+    ASSERT_TRUE(sim.setState(0, scene.q0, scene.v0)) << sim.lastStateError();
+    int closed = 0;
+    for (int c = 0; c < 16; ++c) closed += sim.isClosed(c) ? 1 : 0;
+    EXPECT_EQ(closed, 2) << "one pair of feet in stance";
+    int impacts = 0;
+    double loss = 0;
+    while (sim.time() < 3.0) {
+      const StepStatus st = sim.step(1e-2);
+      ASSERT_TRUE(st.ok) << st.message;
+      const double dloss = sim.impactEnergyLoss() - loss;
+      loss = sim.impactEnergyLoss();
+      if (sim.events().empty()) continue;
+      ++impacts;
+      ASSERT_EQ(sim.events().size(), 4u) << "two touchdowns and two lift-offs at t = " << sim.time();
+      int down = 0, up = 0;
+      for (const ContactEvent& e : sim.events()) {
+        EXPECT_EQ(e.t, sim.time());
+        down += e.kind == ContactEventKind::Touchdown;
+        up += e.kind == ContactEventKind::LiftOff;
+      }
+      EXPECT_EQ(down, 2);
+      EXPECT_EQ(up, 2);
+      const double T_after = sim.kineticEnergy();
+      EXPECT_NEAR(T_after / (T_after + dloss), ratio * ratio, 1e-9) << "impact at t = " << sim.time();
+      closed = 0;
+      for (int c = 0; c < 16; ++c) closed += sim.isClosed(c) ? 1 : 0;
+      EXPECT_EQ(closed, 2);
+    }
+    EXPECT_GE(impacts, 7) << toString(f);
+    EXPECT_LT(sim.velocityResidual(), 1e-12);
+  }
+}

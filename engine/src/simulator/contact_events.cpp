@@ -403,14 +403,24 @@ bool Simulator::forcePhase(std::string& error) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
   const double acc_tol = o.force_tol * (1 + model_.gravity.norm());
+  saveCandidateRows();  // rows at the post-impact velocity (κ depends on v)
+  // Only contacts at rest take part: one that separates (γ > 0, the trailing
+  // foot an impact unloaded) is open, and lifts off if it was closed.
   bool any = false;
-  for (auto& r : u.rows) {
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    auto& r = u.rows[k];
     if (!r.touching) continue;
+    const double gamma = rowVelocity(k);
+    if (gamma > o.speed_tol) {
+      r.touching = false;
+      cdata_->setActive(r.c, false);
+      if (r.was_closed) logEvent(ContactEventKind::LiftOff, k, 0, gamma, 0);
+      continue;
+    }
     any = true;
     r.in_set = !r.lifting && (r.was_closed || r.touching_down);
   }
   if (!any) return true;
-  saveCandidateRows();  // rows at the post-impact velocity (κ depends on v)
   for (int it = 0;; ++it) {
     if (it == o.max_mode_iterations) {
       error = "contact modes: no consistent set of contacts after " + std::to_string(it) +
