@@ -2,12 +2,15 @@
 // (contact_events.hpp), against closed-form motions of a ball.
 #include <gtest/gtest.h>
 
+#include <appell/run.hpp>
 #include <appell/simulator.hpp>
 #include <appell/urdf.hpp>
 
 #include "ball.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 
 using namespace appell;
 using namespace appell::scenes;
@@ -265,5 +268,42 @@ TEST(ContactEvents, RimlessWheelLandsAndLiftsFeetPairwiseWithTheImpactLaw) {
     }
     EXPECT_GE(impacts, 7) << toString(f);
     EXPECT_LT(sim.velocityResidual(), 1e-12);
+  }
+}
+
+// Protects: a robot placed above the floor is not refused; it falls, lands on
+// its wheels and caster and ends resting on all three contacts with bounded
+// residuals. Passive (no wheel torques), it falls flat: all three touch down
+// together at √(2h/g), and E + impact losses is conserved. Driven, the wheel
+// torques pitch it in flight, it lands caster first and rocks between caster
+// and wheels with ever smaller impacts until it rests on all three.
+TEST(ContactEvents, RobotStartedAboveTheGroundFallsLandsAndDrives) {
+  for (bool driven : {false, true}) {
+    Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/diff_drive/diff_drive.urdf");
+    scene.q0[2] += 0.05;  // 5 cm up
+    if (!driven) scene.tau.setZero();
+    RunOptions o = runOptions(scene.settings);
+    o.duration = 2.0;
+    std::vector<double> times;
+    const RunSummary s = runScene(scene, o, [&](const Simulator& sim) { times.push_back(sim.time()); });
+    ASSERT_TRUE(s.ok) << s.failure;
+    ASSERT_GE(s.events.size(), 3u);
+    std::set<std::string> landed;
+    for (const RunEvent& e : s.events) {
+      if (e.kind == ContactEventKind::Touchdown) landed.insert(e.contact);
+      // Each event is a sample (a CSV row) at its time.
+      EXPECT_TRUE(std::find(times.begin(), times.end(), e.t) != times.end()) << e.contact;
+    }
+    EXPECT_EQ(landed.size(), 3u);
+    if (!driven) {
+      ASSERT_EQ(s.events.size(), 3u);
+      for (const RunEvent& e : s.events) EXPECT_NEAR(e.t, std::sqrt(2 * 0.05 / kG), 1e-9) << e.contact;
+      EXPECT_LT(s.relativeEnergyDeviation(), 1e-8);
+    }
+    EXPECT_GT(s.impact_energy_loss, 0.0);
+    EXPECT_LT(s.max_velocity_residual, 1e-12);
+    EXPECT_LT(s.max_gap_residual, 1e-9);
+    EXPECT_LT(s.events.back().t, 0.5) << "it comes to rest on its three contacts";
+    for (const ContactStats& c : s.contacts) EXPECT_EQ(c.pulling, 0) << c.name;
   }
 }

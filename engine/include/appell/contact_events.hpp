@@ -77,8 +77,9 @@ struct ContactEventOptions {
   double speed_tol = 1e-9;        ///< |γ| ≤ speed_tol: at rest, no impact
   double force_tol = 1e-9;        ///< λᵤ < −force_tol pulls (lift-off)
   double time_tol = 1e-12;        ///< events located to this (s)
-  /// Impacts slower than this are plastic: a bouncing contact comes to rest
-  /// after finitely many bounces (docs/contacts.md §7).
+  /// Impacts slower than this are plastic, and a contact that an impact
+  /// would unload into separating slower than this is held: a bouncing or
+  /// rocking body comes to rest after finitely many impacts (docs/contacts.md §7).
   double rest_speed = 1e-3;
   int max_mode_iterations = 64;   ///< pivots of one complementarity problem
   int max_locate_iterations = 60; ///< root-finding iterations per event

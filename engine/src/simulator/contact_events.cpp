@@ -405,13 +405,16 @@ bool Simulator::forcePhase(std::string& error) {
   const double acc_tol = o.force_tol * (1 + model_.gravity.norm());
   saveCandidateRows();  // rows at the post-impact velocity (κ depends on v)
   // Only contacts at rest take part: one that separates (γ > 0, the trailing
-  // foot an impact unloaded) is open, and lifts off if it was closed.
+  // foot an impact unloaded) is open, and lifts off if it was closed. One
+  // that separates slower than rest_speed is held (its velocity projected to
+  // zero): a body rocking between contacts with ever smaller plastic impacts
+  // (an accumulation of impacts in finite time) comes to rest.
   bool any = false;
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
     auto& r = u.rows[k];
     if (!r.touching) continue;
     const double gamma = rowVelocity(k);
-    if (gamma > o.speed_tol) {
+    if (gamma > std::max(o.speed_tol, r.was_closed || r.touching_down ? o.rest_speed : 0.0)) {
       r.touching = false;
       cdata_->setActive(r.c, false);
       if (r.was_closed) logEvent(ContactEventKind::LiftOff, k, 0, gamma, 0);
