@@ -307,3 +307,85 @@ TEST(ContactEvents, RobotStartedAboveTheGroundFallsLandsAndDrives) {
     for (const ContactStats& c : s.contacts) EXPECT_EQ(c.pulling, 0) << c.name;
   }
 }
+
+namespace {
+
+/// A ball (m₁) above a paddle (m₂) that slides vertically on a prismatic
+/// joint, held up by a constant joint force m₂ g; the paddle's top face is
+/// the support, carried by the paddle body (a body–body contact).
+struct BallOnPaddle {
+  Model model;
+  ConstraintList constraints;
+  VecX q0, v0, tau;
+};
+
+BallOnPaddle ballOnPaddle(double m1, double m2, double h, double e) {
+  ModelBuilder b;
+  const int paddle = b.addBody("paddle", -1, SE3::Identity(), JointType::Prismatic, Vec3::UnitZ(),
+                               principalInertia(m2, Vec3(0.1, 0.1, 0.2)), "slide");
+  const double r = 0.1, I = 0.4 * m1 * r * r;
+  const int ball = b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+                             principalInertia(m1, Vec3(I, I, I)), "free");
+  BallOnPaddle s;
+  s.model = b.build();
+  Support top{Plane{}, StaticMotion{}, "paddle_top"};
+  top.body = paddle;
+  ContactSpec spec{ContactKind::Rolling, ball, Sphere{r, Vec3::Zero()}, top};
+  spec.restitution = e;
+  spec.options.name = "ball_paddle";
+  s.constraints.push_back(makeContact(spec));
+  s.q0 = neutralConfiguration(s.model);
+  setFloatingPose(s.q0, 1, Vec3(0, 0, r + h), Mat3::Identity());
+  s.v0 = VecX::Zero(s.model.nv);
+  s.tau = VecX::Zero(s.model.nv);
+  s.tau[0] = m2 * kG;  // the paddle floats
+  return s;
+}
+
+}  // namespace
+
+// Protects: body–body contacts make and break like world contacts (their rows
+// are loop rows of the tree solver). The ball meets the floating paddle at
+// √(2h/g); the impact conserves the vertical momentum: plastic, both move at
+// m₁v/(m₁+m₂) and then fall together at m₁g/(m₁+m₂); elastic, the ball
+// leaves at (m₁−m₂)/(m₁+m₂)·v and the paddle at 2m₁/(m₁+m₂)·v.
+TEST(ContactEvents, BallOnAFloatingPaddleExchangesMomentumAtImpact) {
+  const double m1 = 0.5, m2 = 1.5, h = 0.2;
+  const double t_star = std::sqrt(2 * h / kG), v = -kG * t_star;
+  for (double e : {0.0, 1.0}) {
+    for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+      BallOnPaddle s = ballOnPaddle(m1, m2, h, e);
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                    IntegratorType::DormandPrince54, tight());
+      const VecX tau = s.tau;
+      sim.setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+      EXPECT_FALSE(sim.isClosed(0));
+      std::vector<ContactEvent> events;
+      while (sim.time() < t_star + 0.1) {
+        const StepStatus st = sim.step(1e-2);
+        ASSERT_TRUE(st.ok) << st.message;
+        events.insert(events.end(), sim.events().begin(), sim.events().end());
+        if (!events.empty() && sim.time() == events.front().t) {
+          const double vb = (floatingRotation(sim.q(), 1) * Vec3(sim.v().tail<3>())).z();
+          const double vp = sim.v()[0];
+          if (e == 0) {
+            EXPECT_NEAR(vb, m1 * v / (m1 + m2), 1e-9) << toString(f);
+            EXPECT_NEAR(vp, m1 * v / (m1 + m2), 1e-9) << toString(f);
+          } else {
+            EXPECT_NEAR(vb, (m1 - m2) / (m1 + m2) * v, 1e-9) << toString(f);
+            EXPECT_NEAR(vp, 2 * m1 / (m1 + m2) * v, 1e-9) << toString(f);
+          }
+        }
+      }
+      ASSERT_EQ(events.size(), 1u) << toString(f) << " e = " << e;
+      EXPECT_NEAR(events[0].t, t_star, 1e-10);
+      EXPECT_EQ(events[0].kind, e == 0 ? ContactEventKind::Touchdown : ContactEventKind::Bounce);
+      if (e == 0) {  // together, falling at m₁ g / (m₁ + m₂)
+        const double dt = sim.time() - t_star;
+        EXPECT_NEAR(sim.v()[0], m1 * v / (m1 + m2) - m1 * kG / (m1 + m2) * dt, 1e-9);
+        EXPECT_NEAR(sim.lambda()[2], m1 * m2 * kG / (m1 + m2), 1e-9) << "the ball's load on the paddle";
+      }
+    }
+  }
+}
