@@ -69,6 +69,10 @@ void printContacts(std::ostream& out, const RunSummary& r) {
       out << " (no normal row)\n";
       continue;
     }
+    if (e.min_normal > e.max_normal) {  // no closed sample
+      out << " open throughout (" << e.open_samples << " samples)\n";
+      continue;
+    }
     out << std::setprecision(4) << " normal load " << e.min_normal << " … " << e.max_normal << " N";
     if (!e.tangential_rows.empty()) {
       out << ", friction demand max " << e.max_demand << " at t=" << e.t_max_demand;

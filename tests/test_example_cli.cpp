@@ -4,6 +4,7 @@
 // make_meshes) reproducing the committed files. Needs the `appell` command
 // and the example programs built in the same build tree.
 #include <appell/urdf.hpp>
+#include <appell/trajectory_reader.hpp>
 
 #include "run_command.hpp"
 
@@ -186,6 +187,63 @@ TEST(ExampleGenerators, MakeMeshesReproducesTheCommittedMeshes) {
                                    << " is stale: regenerate it (docs/examples.md)";
   }
 }
+
+// The examples whose contacts make and break (docs/contacts.md §7): they run
+// to the end, list their events, write a CSV row per event with the closed:
+// and event: columns, and (passive) keep E + impact losses constant.
+struct EventCase {
+  const char* file;
+  const char* contact;  ///< a contact whose columns are checked
+  int min_events;
+  int min_event_times;  ///< distinct times with events (several contacts may switch at once)
+};
+
+class ExampleEvents : public ::testing::TestWithParam<EventCase> {};
+
+TEST_P(ExampleEvents, RunListsTheEventsAndWritesARowForEach) {
+  const EventCase c = GetParam();
+  TempDir dir;
+  const std::string csv = dir / "events.csv";
+  const Output o = runCommand(program("cli/appell") + " run " + example(c.file) +
+                              " --duration 3 --quiet --every 1000 --out " + csv);
+  ASSERT_EQ(o.status, 0) << o.output;
+  EXPECT_GE(number(o.output, R"(contact events \(([0-9]+);)"), c.min_events) << o.output;
+  EXPECT_LT(number(o.output, R"(\(([0-9.eE+-]+) relative\))"), 1e-8) << o.output;
+  EXPECT_LT(number(o.output, R"(max \|Av\+b\| = ([0-9.eE+-]+))"), 1e-10) << o.output;
+  const TrajectoryTable t = readTrajectory(csv);
+  const int closed = t.require(std::string("closed:") + c.contact);
+  const int event = t.require(std::string("event:") + c.contact);
+  std::vector<int> events;
+  for (int k = 0; k < static_cast<int>(t.columns.size()); ++k)
+    if (t.columns[k].rfind("event:", 0) == 0) events.push_back(k);
+  int rows_with_events = 0, open_rows = 0;
+  for (const auto& row : t.rows) {
+    bool any = false;
+    for (int k : events) {
+      any = any || row[k] != 0;
+      EXPECT_GE(row[k], 0);
+      EXPECT_LE(row[k], 3);
+    }
+    rows_with_events += any ? 1 : 0;
+    open_rows += row[closed] == 0 ? 1 : 0;
+    EXPECT_TRUE(row[event] == 0 || row[closed] == (row[event] == 1 ? 1 : 0))
+        << "after a touchdown closed, after a bounce or lift-off open";
+  }
+  // --every 1000 keeps few ordinary rows, but every event has its row.
+  EXPECT_GE(rows_with_events, c.min_event_times);
+  EXPECT_LT(static_cast<long>(t.rows.size()), rows_with_events + 10);
+  EXPECT_GT(open_rows, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EventExamples, ExampleEvents,
+    ::testing::Values(EventCase{"bouncing_ball/bouncing_ball.urdf", "floor_contact", 18, 18},
+                      EventCase{"rimless_wheel/rimless_wheel.urdf", "foot1_l", 28, 7}),
+    [](const ::testing::TestParamInfo<EventCase>& p) {
+      std::string n = p.param.file;
+      n = n.substr(n.find('/') + 1);
+      return n.substr(0, n.find('.'));
+    });
 
 }  // namespace
 }  // namespace appell

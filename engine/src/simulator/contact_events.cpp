@@ -148,6 +148,19 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     if (!std::isfinite(fa) || !std::isfinite(fb))
       return fail(st, "event location: the event function of '" +
                           constraints_[u.rows[k].c]->name() + "' is not finite");
+    if (fa <= 0 && !cdata_->isActive(u.rows[k].c)) {
+      // A contact that opened at the step's start (a bounce, a lift-off) has
+      // g(0) ≈ 0 but is separating: its gap is positive just after. Bracket
+      // the root from there.
+      for (double s = 0.5; s > 1e-9 && fa <= 0; s *= 0.25) {
+        if (!stateAt(s * b)) return fail(st, "event location: a shortened step failed");
+        const double f = eventFunction(k);
+        if (f > 0) {
+          a = t_ - u.t0;
+          fa = f;
+        }
+      }
+    }
     if (fa <= 0) {
       b = 0;  // already at (or past) the event at the start: decide there
     } else {
