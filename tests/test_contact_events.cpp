@@ -389,3 +389,33 @@ TEST(ContactEvents, BallOnAFloatingPaddleExchangesMomentumAtImpact) {
     }
   }
 }
+
+// Protects: the bilateral idealisation stays available. A contact declared
+// unilateral = false (or a simulator with events off) never opens: pulled
+// up by F = kt it holds, and its normal force goes negative at t > mg/k.
+TEST(ContactEvents, BilateralContactsHoldWhenPulled) {
+  const double m = 0.5, k = 2.0, t_star = m * kG / k;
+  for (bool per_contact : {true, false}) {
+    BuiltScene s = raisedBall(0.0, Vec3(0, 3.0, 0), Vec3(0.3, 0, 0), 0.0);
+    SimulatorOptions so;
+    if (per_contact) {
+      ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+      spec.unilateral = false;
+      s.constraints[0] = makeContact(spec);
+      EXPECT_FALSE(s.constraints[0]->unilateral());
+    } else {
+      so.contacts.enabled = false;
+    }
+    Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
+                  IntegratorType::DormandPrince54, tight(), so);
+    sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
+      tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(0, 0, k * t);
+    });
+    ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+    const auto events = runCollecting(sim, t_star + 0.5, 1e-2);
+    EXPECT_TRUE(events.empty());
+    EXPECT_TRUE(sim.isClosed(0));
+    EXPECT_NEAR(sim.lambda()[2], m * kG - k * sim.time(), 1e-9) << "the contact pulls";
+    EXPECT_NEAR(centreHeight(sim), 0.1, 1e-12);
+  }
+}

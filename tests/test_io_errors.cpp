@@ -141,3 +141,11 @@ TEST(IoErrors, MisspeltAttributeInSceneBlock) {
   // A misspelt attribute would otherwise be ignored (here: a sphere of radius 0).
   expectError("unknown_attribute.urdf", 6, {"<contact name=\"foot\">", "attribute 'raduis' does not apply to shape=\"sphere\""});
 }
+
+TEST(IoErrors, RestitutionOutsideZeroOneNamesTheContact) {
+  expectError("restitution_range.urdf", 6, {"<contact name=\"foot\">", "restitution must lie in [0, 1]"});
+}
+
+TEST(IoErrors, UnilateralMustBeTrueOrFalse) {
+  expectError("unilateral_value.urdf", 6, {"<contact name=\"foot\">", "'unilateral' must be \"true\""});
+}
