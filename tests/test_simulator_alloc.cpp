@@ -179,6 +179,54 @@ TEST(SimulatorAllocation, CarWithContactRowsDoesNotAllocate) {
   }
 }
 
+// Steps that hold contact events (touchdown, impacts, the active set
+// changing, bounces) allocate nothing either: every row has its storage from
+// the start and the event list is reserved. A ball with restitution 0.5
+// dropped 0.2 m: 9 bounces and a plastic touchdown in 1.5 s, each solver,
+// dopri5 (dense-output location) and RK4 (shortened steps).
+TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
+  ModelBuilder b;
+  const double r = 0.1, m = 0.5, I = 0.4 * m * r * r;
+  const int ball = b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+                             Inertia{m, Vec3::Zero(), Vec3::Constant(I).asDiagonal()});
+  const Model model = b.build();
+  ContactSpec spec{ContactKind::Rolling, ball, Sphere{r, Vec3::Zero()},
+                   Support{Plane{}, StaticMotion{}, "ground", -1}};
+  spec.restitution = 0.5;
+  const ConstraintList c{makeContact(spec)};
+  VecX q = neutralConfiguration(model);
+  q[2] = r + 0.2;
+  VecX v = VecX::Zero(model.nv);
+  v.head<3>() = Vec3(0, 4.0, 1.0);  // spinning: the impacts are rolling impacts
+  v[3] = 0.3;
+  for (int which = 0; which < 3; ++which) {
+    for (IntegratorType it : {IntegratorType::RK4, IntegratorType::DormandPrince54}) {
+      std::unique_ptr<ConstrainedSolver> solver;
+      if (which == 0) solver = std::make_unique<KktSolver>(model, c);
+      if (which == 1) solver = std::make_unique<AppellSolver>(model, c);
+      if (which == 2) solver = makeSolver(Formulation::Tree, model, c);
+      SimulatorOptions so;
+      so.contacts.rest_speed = 0.01;
+      Simulator sim(model, c, std::move(solver), it, {}, so);
+      ASSERT_TRUE(sim.setState(0, q, v));
+      long allocations = 0, events = 0;
+      while (sim.time() < 1.5) {
+        StepStatus st;
+        {
+          Arm arm;
+          st = sim.step(2e-3);
+          allocations += g_allocations;
+        }
+        ASSERT_TRUE(st.ok) << st.message;
+        events += st.events;
+      }
+      EXPECT_GE(events, 8) << "solver " << which << ", " << toString(it);
+      EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
+      EXPECT_TRUE(sim.isClosed(0));
+    }
+  }
+}
+
 // The counter works: a step that fails (and builds its message) does allocate.
 TEST(SimulatorAllocation, CounterSeesAllocations) {
   Arm arm;

@@ -24,7 +24,6 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
       model_, constraints_, solver_->usesDenseRows() ? DenseRows::Sized : DenseRows::None);
   projector_ = std::make_unique<PositionProjector>(model_, constraints_, options_.projection);
   field_ = std::make_unique<Field>(*this);
-  setUpUnilateral();
   q_ = neutralConfiguration(model_);
   v_ = VecX::Zero(model_.nv);
   q_prev_ = q_;
@@ -34,6 +33,7 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   result_.vdot = VecX::Zero(model_.nv);
   result_.lambda = VecX::Zero(cdata_->m);
   result_.reaction = VecX::Zero(model_.nv);
+  setUpUnilateral();  // after q_, v_: its workspace copies their sizes
   // Size every per-step buffer of the field and the solver once, here.
   std::string ignored;
   evaluateEndState(ignored);
