@@ -419,3 +419,53 @@ TEST(ContactEvents, BilateralContactsHoldWhenPulled) {
     EXPECT_NEAR(centreHeight(sim), 0.1, 1e-12);
   }
 }
+
+// Protects: a rolling impact whose no-slip impulse leaves the friction cone
+// is reported (sliding impacts arrive with friction). The backspinning ball
+// of examples/bouncing_ball needs |Λₜ| = 0.43 N·s against Λₙ = 3.54 N·s at
+// its first impact: inside the cone for μ = 0.8, outside for μ = 0.05.
+TEST(ContactEvents, ImpulsesOutsideTheFrictionConeAreFlagged) {
+  for (double mu : {0.8, 0.05}) {
+    Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/bouncing_ball/bouncing_ball.urdf");
+    ContactSpec spec = scene.contacts[0]->spec();
+    spec.mu = mu;
+    scene.contacts[0] = makeContact(spec);
+    scene.constraints[0] = scene.contacts[0];
+    RunOptions o = runOptions(scene.settings);
+    o.duration = 0.5;
+    const RunSummary s = runScene(scene, o);
+    ASSERT_TRUE(s.ok) << s.failure;
+    ASSERT_EQ(s.events.size(), 1u);
+    const RunEvent& e = s.events[0];
+    EXPECT_NEAR(e.tangential_impulse / e.normal_impulse, 0.428571 / 3.54356, 1e-5);
+    EXPECT_EQ(e.outside_friction_cone, mu < 0.1) << "μ = " << mu;
+  }
+}
+
+// Protects: simultaneous touchdowns decided together. The car of
+// examples/car dropped level from 10 cm lands on its four tyres at once
+// (one impact problem with 12 rows of rank 9); tree and KKT agree on the
+// post-impact state and both leave all four closed.
+TEST(ContactEvents, CarDroppedLevelLandsOnFourWheelsAtOnce) {
+  std::vector<VecX> after;
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
+    Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf");
+    scene.q0[2] += 0.1;
+    scene.tau.setZero();
+    Simulator sim(scene.model, scene.constraints, makeSolver(f, scene.model, scene.constraints),
+                  IntegratorType::DormandPrince54, tight());
+    ASSERT_TRUE(sim.setState(0, scene.q0, scene.v0));
+    for (int c = 0; c < 4; ++c) EXPECT_FALSE(sim.isClosed(c));
+    const auto events = runCollecting(sim, 0.3, 1e-2);
+    ASSERT_EQ(events.size(), 4u) << toString(f);
+    for (const ContactEvent& e : events) {
+      EXPECT_EQ(e.kind, ContactEventKind::Touchdown);
+      EXPECT_NEAR(e.t, std::sqrt(2 * 0.1 / kG), 1e-10);
+      EXPECT_GT(e.normal_impulse, 0);
+    }
+    for (int c = 0; c < 4; ++c) EXPECT_TRUE(sim.isClosed(c));
+    EXPECT_LT(sim.velocityResidual(), 1e-12);
+    after.push_back(sim.v());
+  }
+  EXPECT_LT((after[0] - after[1]).lpNorm<Eigen::Infinity>(), 1e-9);
+}
