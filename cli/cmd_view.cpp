@@ -150,6 +150,8 @@ struct Frame {
   double t;
   std::vector<double> poses, points, forces;  // 7 per body, 3 per constraint, 3 per constraint
   std::vector<double> supports;                // 7 per support: its frame in the world
+  std::vector<double> closed;                  // 1 per constraint: 1 closed, 0 open (lifted off)
+  std::vector<std::pair<int, int>> events;     // (constraint, 1 + ContactEventKind) at this time
 };
 
 void appendPose(std::vector<double>& out, const SE3& X) {
@@ -160,7 +162,7 @@ void appendPose(std::vector<double>& out, const SE3& X) {
 Frame frameAt(const Scene& scene, Data& data, std::vector<RowBlock>& blocks, double t,
               const VecX& q, const VecX& v, const VecX& lambda) {
   const Model& m = scene.model;
-  Frame f{t, {}, {}, {}, {}};
+  Frame f{t, {}, {}, {}, {}, std::vector<double>(scene.constraints.size(), 1.0), {}};
   forwardKinematics(m, data, q, v);
   for (int b = 0; b < m.nbodies; ++b) appendPose(f.poses, data.oMi[b]);
   // A support frame moves as its motion says, or rides on its body (supports.hpp).
@@ -192,6 +194,12 @@ std::vector<Frame> framesFromTrajectory(const Scene& scene, const std::string& p
   for (int i = 0; i < m.nv; ++i) vcol.push_back(table.require(names[1 + m.nq + i]));
   for (const std::string& n : names)
     if (n.rfind("lambda:", 0) == 0) lcol.push_back(table.require(n));
+  // Contact modes and events (unilateral contacts; absent in older files).
+  std::vector<int> closed_col(scene.constraints.size(), -1), event_col(scene.constraints.size(), -1);
+  for (size_t c = 0; c < scene.constraints.size(); ++c) {
+    closed_col[c] = table.find("closed:" + scene.constraints[c]->name());
+    event_col[c] = table.find("event:" + scene.constraints[c]->name());
+  }
   Data data(m);
   std::vector<RowBlock> blocks(scene.constraints.size());
   for (size_t c = 0; c < blocks.size(); ++c) scene.constraints[c]->reserve(m, blocks[c]);
@@ -202,6 +210,11 @@ std::vector<Frame> framesFromTrajectory(const Scene& scene, const std::string& p
     for (int i = 0; i < m.nv; ++i) v[i] = row[vcol[i]];
     for (size_t i = 0; i < lcol.size(); ++i) lambda[i] = row[lcol[i]];
     frames.push_back(frameAt(scene, data, blocks, row[0], q, v, lambda));
+    for (size_t c = 0; c < scene.constraints.size(); ++c) {
+      if (closed_col[c] >= 0) frames.back().closed[c] = row[closed_col[c]];
+      if (event_col[c] >= 0 && row[event_col[c]] != 0)
+        frames.back().events.emplace_back(static_cast<int>(c), static_cast<int>(row[event_col[c]]));
+    }
   }
   return frames;
 }
@@ -276,10 +289,17 @@ std::string pageJson(const Scene& scene, const std::vector<Frame>& frames) {
   j.key("times").open('[');
   for (const Frame& f : frames) j.num(f.t);
   j.close(']');
-  for (const auto member : {&Frame::poses, &Frame::points, &Frame::forces, &Frame::supports}) {
+  // Contact events for the time line: [t, contact, kind name].
+  j.key("events").open('[');
+  for (const Frame& f : frames)
+    for (const auto& [c, code] : f.events)
+      j.open('[').num(f.t).num(c).str(toString(static_cast<ContactEventKind>(code - 1))).close(']');
+  j.close(']');
+  for (const auto member : {&Frame::poses, &Frame::points, &Frame::forces, &Frame::supports, &Frame::closed}) {
     j.key(member == &Frame::poses    ? "poses"
           : member == &Frame::points ? "points"
           : member == &Frame::forces ? "forces"
+          : member == &Frame::closed ? "closed"
                                      : "supportPoses")
         .open('[');
     for (const Frame& f : frames) j.vec(f.*member);

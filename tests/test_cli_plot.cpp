@@ -173,4 +173,19 @@ TEST_F(CliPlot, ViewPageCarriesTheRun) {
   EXPECT_NE(wrong.output.find("no column 'q:root_joint.x'"), std::string::npos) << wrong.output;
 }
 
+// The page carries the contact events for its time line and the contact
+// modes (an open contact is not drawn): the bouncing ball's first bounce at
+// t* = √(2·1/g) is there, with the contact open while in flight.
+TEST_F(CliPlot, ViewPageMarksContactEvents) {
+  const std::string ball = std::string(APPELL_SOURCE_DIR) + "/examples/bouncing_ball/bouncing_ball.urdf";
+  const fs::path csv = kWork / "ball.csv", page = kWork / "ball.html";
+  ASSERT_EQ(sh("run " + ball + " --duration 1 --quiet --every 50 --out " + csv.string()).status, 0);
+  const Result r = sh("view " + ball + " --trajectory " + csv.string() + " --out " + page.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string html = slurp(page);
+  EXPECT_NE(html.find("\"events\":[[0.45152364"), std::string::npos) << "first bounce on the time line";
+  EXPECT_NE(html.find(",0,\"bounce\"]"), std::string::npos);
+  EXPECT_NE(html.find("\"closed\":[[0],"), std::string::npos) << "in flight at t = 0";
+}
+
 }  // namespace

@@ -202,15 +202,19 @@ function show(t) {
   for (let c = 0; c < nc; ++c) {
     lerp3(p0, data.points[i], data.points[j], 3 * c, w);
     lerp3(f, data.forces[i], data.forces[j], 3 * c, w);
+    // An open contact (lifted off, in flight: closed = 0 at this sample) has
+    // no contact point and no force.
+    const closed = !data.closed || data.closed[w < 1 ? i : j][c] !== 0;
     contacts[c].dot.position.copy(p0);
+    contacts[c].dot.visible = closed;
     const a = contacts[c].arrow, len = f.length() * arrowScale;
-    a.visible = len > 1e-9;
+    a.visible = closed && len > 1e-9;
     if (a.visible) {
       a.position.copy(p0);
       a.setDirection(f.clone().normalize());
       a.setLength(len, Math.min(0.3 * len, 0.04 * extent), Math.min(0.15 * len, 0.02 * extent));
     }
-    lines.push(`${data.contacts[c].name}: |f| = ${f.length().toFixed(3)} N`);
+    lines.push(`${data.contacts[c].name}: ` + (closed ? `|f| = ${f.length().toFixed(3)} N` : 'open'));
   }
   const drawn = Math.max(2, i + 2);
   for (const p of paths) p.geometry.setDrawRange(0, Math.min(drawn, ns));
@@ -263,6 +267,25 @@ window.addEventListener('resize', () => {
   camera.updateProjectionMatrix();
   render();
 });
+// ---- contact events on the time line: a tick per event time (touchdown
+// green, bounce blue, lift-off red); clicking one shows that instant.
+{
+  const marks = document.getElementById('marks'), colour = { touchdown: '#2a9d2a', bounce: '#3a7dc9', lift_off: '#c0392b' };
+  const byTime = new Map();
+  for (const [te, c, kind] of data.events) {
+    if (!byTime.has(te)) byTime.set(te, []);
+    byTime.get(te).push(`${kind} ${data.contacts[c].name}`);
+  }
+  for (const [te, what] of byTime) {
+    const tick = document.createElement('div');
+    tick.className = 'mark';
+    tick.style.left = `${100 * toSlider(te) / 1000}%`;
+    tick.style.background = colour[what[0].split(' ')[0]] || '#555';
+    tick.title = `t = ${te.toPrecision(12)} s: ` + what.join(', ');
+    tick.addEventListener('click', () => { setPlaying(false); t = te; slider.value = toSlider(t); show(t); });
+    marks.appendChild(tick);
+  }
+}
 slider.value = toSlider(t);
 show(t);
 if (opts.play === '1') setPlaying(true);
