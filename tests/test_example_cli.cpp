@@ -222,12 +222,12 @@ TEST_P(ExampleEvents, RunListsTheEventsAndWritesARowForEach) {
     for (int k : events) {
       any = any || row[k] != 0;
       EXPECT_GE(row[k], 0);
-      EXPECT_LE(row[k], 3);
+      EXPECT_LE(row[k], 5);
     }
     rows_with_events += any ? 1 : 0;
     open_rows += row[closed] == 0 ? 1 : 0;
-    EXPECT_TRUE(row[event] == 0 || row[closed] == (row[event] == 1 ? 1 : 0))
-        << "after a touchdown closed, after a bounce or lift-off open";
+    EXPECT_TRUE(row[event] == 0 || row[closed] == (row[event] == 2 || row[event] == 3 ? 0 : 1))
+        << "after a bounce or lift-off open; after a touchdown, slip or stick closed";
   }
   // --every 1000 keeps few ordinary rows, but every event has its row.
   EXPECT_GE(rows_with_events, c.min_event_times);

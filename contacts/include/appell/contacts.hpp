@@ -58,8 +58,9 @@ struct ContactSpec {
   int body = -1;                    ///< the body carrying the shape
   Shape shape;                      ///< in that body's frame
   Support support;
-  /// Coulomb friction coefficient (∞: no limit). The rows do not read it yet;
-  /// the friction check of `appell run` does.
+  /// Coulomb friction coefficient (∞: no limit, ideal rolling). With a
+  /// finite μ a unilateral contact sticks while |λₜ| ≤ μ λₙ and slides
+  /// beyond (docs/contacts.md §8); 0: frictionless sliding.
   double mu = std::numeric_limits<double>::infinity();
   /// The contact can open: it lifts off when its normal force would pull and
   /// closes when its gap reaches zero (contact_events.hpp). false: a
@@ -90,6 +91,8 @@ class ShapeContact : public Constraint {
   /// The normal row, when the contact is unilateral (spec().unilateral).
   int unilateralRow() const override;
   double restitution() const override { return spec_.restitution; }
+  /// Coulomb's μ of the tangent/lateral rows (spec().mu; ∞: ideal rolling).
+  double friction() const override { return spec_.mu; }
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;

@@ -21,6 +21,7 @@
 
 #include <appell/data.hpp>
 
+#include <limits>
 #include <string>
 
 namespace appell {
@@ -92,6 +93,12 @@ class Constraint {
   /// Newton's coefficient of restitution on the unilateral row at an impact
   /// (0: plastic). Only read when unilateral().
   virtual double restitution() const { return 0; }
+  /// Coulomb's coefficient μ of the friction rows (tangent and lateral
+  /// rows, isTangential()): while |λₜ| ≤ μ λₙ the contact sticks (all rows
+  /// hold); beyond it slides — its friction rows are replaced by the force
+  /// −μ λₙ ŝ against the slip direction (docs/contacts.md §8). ∞: never
+  /// slides (ideal rolling). Only read when unilateral().
+  virtual double friction() const { return std::numeric_limits<double>::infinity(); }
   /// Constant-size storage the block needs (called once, outside the step).
   virtual void reserve(const Model& model, RowBlock& block) const;
   /// Writes the rows at (q, v, t). `data` holds forwardKinematics(q, v).

@@ -48,10 +48,27 @@ struct ConstraintData {
   /// holds zero rows for them, projections and residuals skip them. Only
   /// unilateral constraints open (the simulator's active set, contact_events).
   std::vector<char> active;
-  int m_active = 0;                ///< rows of the closed constraints
+  int m_active = 0;                ///< rows of the closed constraints (sliding: the normal row)
   bool isActive(int constraint) const { return active[constraint] != 0; }
   /// Opens or closes a constraint (keeps m_active); no allocation.
   void setActive(int constraint, bool closed);
+
+  /// Per constraint: closed and sliding (docs/contacts.md §8). Only its
+  /// unilateral (normal) row holds; its friction rows are kept in `slide`
+  /// (directions and slip velocities) and zeroed in the block, like an open
+  /// contact's; its other rows (spin) are dropped.
+  std::vector<char> sliding;
+  struct SlidingRows {
+    int n = 0;                               ///< friction rows (tangent1/2, lateral)
+    int row[3] = {-1, -1, -1};               ///< their indices in the constraint
+    Eigen::Matrix<double, 3, 6> Wa = Eigen::Matrix<double, 3, 6>::Zero();  ///< covectors on body A
+    Eigen::Matrix<double, 3, 6> Wb = Eigen::Matrix<double, 3, 6>::Zero();  ///< and on body B
+    Vec3 slip = Vec3::Zero();                ///< row values: the slip velocity along each
+  };
+  std::vector<SlidingRows> slide;            ///< per constraint (n = 0: no friction rows)
+  bool isSliding(int constraint) const { return sliding[constraint] != 0; }
+  /// Makes a closed constraint slide or stick (keeps m_active); no allocation.
+  void setSliding(int constraint, bool slides);
   bool singular = false;           ///< some constraint reported singular geometry
   std::string singular_reason;     ///< "<constraint>: <reason>" of the first one
 

@@ -54,8 +54,11 @@ enum class ContactEventKind {
   Touchdown,  ///< an open contact's gap reached 0; it closed (after the impact, if any)
   Bounce,     ///< it touched down and rebounded (restitution): it stays open
   LiftOff,    ///< a closed contact's normal force reached 0; it opened
+  Slip,       ///< a sticking contact's friction demand reached μ: it slides
+  Stick,      ///< a sliding contact's slip stopped and sticking holds: it sticks
 };
-/// "touchdown", "bounce", "lift_off": the names of the run summary and CSV.
+/// "touchdown", "bounce", "lift_off", "slip", "stick": the names of the run
+/// summary and CSV.
 std::span<const NamedValue<ContactEventKind>> contactEventKindTable();
 const char* toString(ContactEventKind kind);
 

@@ -29,6 +29,10 @@
 
 namespace appell {
 
+namespace detail {
+enum class Crossing;
+}
+
 struct SimulatorOptions {
   bool project_positions = true;   ///< Newton on the holonomic gaps after every step
   bool project_velocities = true;  ///< impulse solve after every step
@@ -136,9 +140,13 @@ class Simulator {
   void restore();
   // Unilateral constraints (simulator/contact_events.cpp).
   void setUpUnilateral();
-  int crossedConstraint() const;
+  int crossedConstraint(detail::Crossing& type) const;
+  bool solveDynamics(double t, const VecX& q, const VecX& v, const VecX& tau,
+                     ConstrainedResult& out, SolveOutputs outputs = SolveOutputs::All);
+  bool frictionPhase(std::string& error);
+  Vec3 frictionForce(int k, const VecX& lambda) const;
   StepStatus locateAndHandleEvent(StepStatus st, double h);
-  double eventFunction(int u);
+  double eventFunction(int u, detail::Crossing type);
   bool restepTo(double tau, StepStatus& st);
   bool decideModes(std::string& error);
   bool projectAfterModes(std::string& error);

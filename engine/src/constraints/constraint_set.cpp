@@ -21,6 +21,14 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
     m += constraints[k]->rows();
   }
   active.assign(constraints.size(), 1);
+  sliding.assign(constraints.size(), 0);
+  slide.resize(constraints.size());
+  for (size_t k = 0; k < constraints.size(); ++k) {
+    const Constraint& c = *constraints[k];
+    if (c.jointSpace() || !c.unilateral()) continue;
+    for (int r = 0; r < c.rows() && slide[k].n < 3; ++r)
+      if (isTangential(c.rowKind(r))) slide[k].row[slide[k].n++] = r;
+  }
   m_active = m;
   b = VecX::Zero(m);
   gap = VecX::Zero(m);
@@ -32,12 +40,24 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
   }
 }
 
+namespace {
+int rowsOf(const ConstraintData& cd, int c) {
+  return c + 1 < static_cast<int>(cd.offset.size()) ? cd.offset[c + 1] - cd.offset[c] : cd.m - cd.offset[c];
+}
+}  // namespace
+
 void ConstraintData::setActive(int constraint, bool closed) {
   if (isActive(constraint) == closed) return;
   active[constraint] = closed ? 1 : 0;
-  const int rows = constraint + 1 < static_cast<int>(offset.size()) ? offset[constraint + 1] - offset[constraint]
-                                                                   : m - offset[constraint];
+  const int rows = isSliding(constraint) ? 1 : rowsOf(*this, constraint);
   m_active += closed ? rows : -rows;
+  sliding[constraint] = 0;  // an open contact neither sticks nor slides; it closes sticking
+}
+
+void ConstraintData::setSliding(int constraint, bool slides) {
+  if (isSliding(constraint) == slides) return;
+  sliding[constraint] = slides ? 1 : 0;
+  if (isActive(constraint)) m_active += (slides ? -1 : 1) * (rowsOf(*this, constraint) - 1);
 }
 
 void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList& constraints,
@@ -78,6 +98,28 @@ void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList
         cd.gap.segment(o, m) = blk.gap;
       }
       continue;
+    }
+    if (cd.isSliding(static_cast<int>(k))) {
+      // Sliding: keep the friction rows' directions and slip velocities, then
+      // leave only the normal row.
+      ConstraintData::SlidingRows& sr = cd.slide[k];
+      const int a = c.bodyA(), bb = c.bodyB();
+      const Vec6 Va = a >= 0 ? Vec6(data.oMi[a].act(data.v[a])) : Vec6::Zero();
+      const Vec6 Vb = bb >= 0 ? Vec6(data.oMi[bb].act(data.v[bb])) : Vec6::Zero();
+      for (int i = 0; i < sr.n; ++i) {
+        const int r = sr.row[i];
+        sr.Wa.row(i) = blk.Wa.row(r);
+        sr.Wb.row(i) = blk.Wb.row(r);
+        sr.slip[i] = blk.b[r] + (a >= 0 ? blk.Wa.row(r).dot(Va) : 0.0) -
+                     (bb >= 0 ? blk.Wb.row(r).dot(Vb) : 0.0);
+      }
+      const int keep = c.unilateralRow();
+      for (int r = 0; r < m; ++r) {
+        if (r == keep) continue;
+        blk.Wa.row(r).setZero();
+        blk.Wb.row(r).setZero();
+        blk.b[r] = blk.kappa[r] = 0;
+      }
     }
     if (c.jointSpace()) {
       cd.b.segment(o, m) = blk.b_joint;

@@ -18,6 +18,8 @@ std::span<const NamedValue<ContactEventKind>> contactEventKindTable() {
       {ContactEventKind::Touchdown, "touchdown", {}, "an open contact's gap reached 0: it closed"},
       {ContactEventKind::Bounce, "bounce", {}, "it touched down and rebounded (restitution)"},
       {ContactEventKind::LiftOff, "lift_off", {"liftoff"}, "a closed contact's normal force reached 0: it opened"},
+      {ContactEventKind::Slip, "slip", {}, "a sticking contact's friction demand reached μ: it slides"},
+      {ContactEventKind::Stick, "stick", {}, "a sliding contact stopped slipping and sticking holds"},
   };
   return table;
 }
@@ -52,6 +54,14 @@ void Simulator::setUpUnilateral() {
     r.a = con.bodyA();
     r.b = con.bodyB();
     if (r.joint) r.a_joint = VecX::Zero(model_.nv);
+    const double mu = con.friction();
+    if (!(mu >= 0))
+      throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has friction μ = " +
+                                  std::to_string(mu) + " (must be ≥ 0)");
+    if (std::isfinite(mu) && cdata_->slide[c].n > 0) {
+      r.mu = mu;
+      r.nf = cdata_->slide[c].n;
+    }
     uni_->rows.push_back(r);
   }
   if (!uni_) return;
@@ -65,23 +75,55 @@ void Simulator::setUpUnilateral() {
   u.res.lambda = VecX::Zero(cdata_->m);
   u.res.reaction = VecX::Zero(model_.nv);
   events_.reserve(64);
+  int kf = 0;
+  for (const auto& r : u.rows) kf += r.nf > 0 ? 1 : 0;
+  u.sliding.reserve(u.rows.size());
+  u.G = MatX::Zero(model_.nv, kf);
+  u.J = MatX::Zero(6, model_.nv);
+  u.R = MatX::Zero(kf, kf);
+  u.lam0 = VecX::Zero(kf);
+  u.s = VecX::Zero(kf);
+  u.tau_f = VecX::Zero(model_.nv);
+  u.unit = u.res;
 }
 
 // ---------------------------------------------------------------- detection
 
 /// The first unilateral constraint whose event function changed sign over
-/// the step just taken (end state in cdata_ and result_), or −1.
-int Simulator::crossedConstraint() const {
+/// the step just taken (end state in cdata_ and result_), or −1, and which
+/// function: an open gap (touchdown), a closed normal force (lift-off), a
+/// sticking friction demand beyond μ (slip), a sliding slip reversed (stick).
+int Simulator::crossedConstraint(detail::Crossing& type) const {
+  using detail::Crossing;
+  const double ftol = options_.contacts.force_tol;
   for (int k = 0; k < static_cast<int>(uni_->rows.size()); ++k) {
     const UnilateralRow& r = uni_->rows[k];
-    if (cdata_->isActive(r.c)) {
-      if (options_.evaluate_end_state && result_.lambda[r.global] < -options_.contacts.force_tol)
-        return k;
-    } else if (cdata_->gap[r.global] < 0) {
-      return k;
+    type = Crossing::None;
+    if (!cdata_->isActive(r.c)) {
+      if (cdata_->gap[r.global] < 0) type = Crossing::Gap;
+    } else if (options_.evaluate_end_state) {
+      const double fn = result_.lambda[r.global];
+      if (fn < -ftol) type = Crossing::Normal;
+      else if (r.nf > 0 && !cdata_->isSliding(r.c) &&
+               frictionForce(k, result_.lambda).norm() > r.mu * fn + ftol)
+        type = Crossing::Cone;
+      else if (r.nf > 0 && cdata_->isSliding(r.c) &&
+               cdata_->slide[r.c].slip.head(r.nf).dot(r.dir_start.head(r.nf)) <
+                   -options_.contacts.speed_tol)
+        type = Crossing::Slip;
     }
+    if (type != Crossing::None) return k;
   }
   return -1;
+}
+
+/// The friction rows' multipliers of unilateral row k (up to 3).
+Vec3 Simulator::frictionForce(int k, const VecX& lambda) const {
+  const UnilateralRow& r = uni_->rows[k];
+  const auto& sr = cdata_->slide[r.c];
+  Vec3 f = Vec3::Zero();
+  for (int i = 0; i < sr.n; ++i) f[i] = lambda[cdata_->offset[r.c] + sr.row[i]];
+  return f;
 }
 
 /// Integrates from the step's start by τ (no projection): the state the
@@ -102,15 +144,20 @@ bool Simulator::restepTo(double tau, StepStatus& st) {
 }
 
 /// Event function of unilateral row k at the current (t_, q_, v_): the gap
-/// while open, λᵤ while closed (one solve).
-double Simulator::eventFunction(int k) {
+/// while open; while closed λᵤ, or μλₙ − |λₜ| (sticking), or the slip along
+/// its direction at the step's start (sliding) — one solve when it needs λ.
+double Simulator::eventFunction(int k, detail::Crossing type) {
+  using detail::Crossing;
   const UnilateralRow& r = uni_->rows[k];
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  if (!cdata_->isActive(r.c)) return cdata_->gap[r.global];
+  if (type == Crossing::Gap) return cdata_->gap[r.global];
+  if (type == Crossing::Slip) return cdata_->slide[r.c].slip.head(r.nf).dot(r.dir_start.head(r.nf));
   tau_.setZero();
   if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
-  solver_->solve(model_, *data_, constraints_, *cdata_, q_, v_, tau_, uni_->res);
-  return uni_->res.ok ? uni_->res.lambda[r.global] : std::numeric_limits<double>::quiet_NaN();
+  if (!solveDynamics(t_, q_, v_, tau_, uni_->res)) return std::numeric_limits<double>::quiet_NaN();
+  const double fn = uni_->res.lambda[r.global];
+  if (type == Crossing::Normal) return fn;
+  return r.mu * fn - frictionForce(k, uni_->res.lambda).norm();
 }
 
 StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
@@ -120,7 +167,8 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
   u.t0 = t_prev_;
   u.q0 = q_prev_;
   u.v0 = v_prev_;
-  int k = crossedConstraint();
+  detail::Crossing type = detail::Crossing::None;
+  int k = crossedConstraint(type);
   double hi = h;
   // The event functions along the step: on the integrator's dense output
   // when it has one (Dormand–Prince: no new evaluations), else on steps from
@@ -141,20 +189,21 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     // Illinois (modified regula falsi) on φ_k(τ) over [0, hi]: φ(0) ≥ 0 > φ(hi).
     double a = 0, b = hi;
     if (!stateAt(a)) return fail(st, "event location: the step from the last state failed");
-    double fa = eventFunction(k);
+    double fa = eventFunction(k, type);
     if (!stateAt(b)) return fail(st, "event location: the step from the last state failed");
     b = t_ - u.t0;
-    double fb = eventFunction(k);
+    double fb = eventFunction(k, type);
     if (!std::isfinite(fa) || !std::isfinite(fb))
       return fail(st, "event location: the event function of '" +
                           constraints_[u.rows[k].c]->name() + "' is not finite");
-    if (fa <= 0 && !cdata_->isActive(u.rows[k].c)) {
+    if (fa <= 0 && (type == detail::Crossing::Gap || type == detail::Crossing::Slip)) {
       // A contact that opened at the step's start (a bounce, a lift-off) has
-      // g(0) ≈ 0 but is separating: its gap is positive just after. Bracket
+      // g(0) ≈ 0 but is separating: its gap is positive just after; one that
+      // started sliding there has zero slip, positive just after. Bracket
       // the root from there.
       for (double s = 0.5; s > 1e-9 && fa <= 0; s *= 0.25) {
         if (!stateAt(s * b)) return fail(st, "event location: a shortened step failed");
-        const double f = eventFunction(k);
+        const double f = eventFunction(k, type);
         if (f > 0) {
           a = t_ - u.t0;
           fa = f;
@@ -170,7 +219,7 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
         if (!(c > a && c < b)) c = 0.5 * (a + b);
         if (!stateAt(c)) return fail(st, "event location: a shortened step failed");
         c = t_ - u.t0;  // an adaptive method may have taken less than asked
-        const double fc = eventFunction(k);
+        const double fc = eventFunction(k, type);
         if (!std::isfinite(fc)) return fail(st, "event location: non-finite event function");
         if (fc > 0) {
           a = c;
@@ -191,19 +240,25 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     hi = t_ - u.t0;
     evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     int earlier = -1;
+    detail::Crossing earlier_type = detail::Crossing::None;
     for (int j = 0; j < static_cast<int>(u.rows.size()) && earlier < 0; ++j) {
       if (j == k) continue;
       const UnilateralRow& r = u.rows[j];
-      if (!cdata_->isActive(r.c) && cdata_->gap[r.global] < -o.gap_tol) earlier = j;
-    }
-    if (earlier < 0 && options_.evaluate_end_state) {
-      for (int j = 0; j < static_cast<int>(u.rows.size()) && earlier < 0; ++j) {
-        if (j == k || !cdata_->isActive(u.rows[j].c)) continue;
-        if (eventFunction(j) < -o.force_tol) earlier = j;
+      if (!cdata_->isActive(r.c)) {
+        if (cdata_->gap[r.global] < -o.gap_tol) earlier = j, earlier_type = detail::Crossing::Gap;
+      } else if (cdata_->isSliding(r.c)) {
+        if (eventFunction(j, detail::Crossing::Slip) < -o.speed_tol)
+          earlier = j, earlier_type = detail::Crossing::Slip;
+      } else if (options_.evaluate_end_state) {
+        if (eventFunction(j, detail::Crossing::Normal) < -o.force_tol)
+          earlier = j, earlier_type = detail::Crossing::Normal;
+        else if (r.nf > 0 && eventFunction(j, detail::Crossing::Cone) < -o.force_tol)
+          earlier = j, earlier_type = detail::Crossing::Cone;
       }
     }
     if (earlier < 0) break;
     k = earlier;
+    type = earlier_type;
   }
   if (dense && !restepTo(hi, st))  // the step itself, to the event
     return fail(st, "event location: the step to the event failed");
@@ -220,19 +275,40 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     r.touching_down = false;
   }
   UnilateralRow& ev = u.rows[k];
-  if (cdata_->isActive(ev.c)) ev.lifting = true;
-  else ev.touching_down = true;
+  if (type == detail::Crossing::Normal) ev.lifting = true;
+  if (type == detail::Crossing::Gap) ev.touching_down = true;
   st.h_taken = hi;
-  // Drift control on the old set, the modes, then drift control on the new set.
+  // Drift control on the old set (the closed rows' velocity drift is not
+  // slip, the open ones' approach speed stays), the modes, then drift
+  // control on the new set.
   std::string error;
-  if (options_.project_positions) {
-    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
-    if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
-  }
+  if (!projectAfterModes(error)) return fail(st, error);
   const double T_before = appell::kineticEnergy(model_, *data_, q_, v_);
-  if (!decideModes(error)) return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+  if (type == detail::Crossing::Cone || type == detail::Crossing::Slip) {
+    // Friction: the contact starts sliding against its sticking force, or
+    // its slip stopped and it sticks if the cone allows (frictionPhase).
+    if (type == detail::Crossing::Slip) {
+      cdata_->setSliding(ev.c, false);
+    } else {  // at the cone's edge: slide against the sticking force
+      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+      tau_.setZero();
+      if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
+      if (!solveDynamics(t_, q_, v_, tau_, u.res)) return fail(st, u.res.error);
+      const Vec3 ft = frictionForce(k, u.res.lambda);
+      if (ft.norm() > 0) ev.dir = -ft / ft.norm();
+      ev.dir_start = ev.dir;
+      cdata_->setSliding(ev.c, true);
+      logEvent(ContactEventKind::Slip, k, 0, 0, 0);
+    }
+    if (!frictionPhase(error)) return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+    if (type == detail::Crossing::Slip && !cdata_->isSliding(ev.c))
+      logEvent(ContactEventKind::Stick, k, 0, 0, 0);
+  } else if (!decideModes(error) || !frictionPhase(error)) {
+    return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+  }
   if (!projectAfterModes(error)) return fail(st, error);
   dissipated_ += T_before - appell::kineticEnergy(model_, *data_, q_, v_);
+  for (auto& r : u.rows) r.dir_start = r.dir;  // the next step's slip reference
   integrator_->reset();
   if (!evaluateEndState(error)) return fail(st, error);
   st.events = static_cast<int>(events_.size());
@@ -448,8 +524,7 @@ bool Simulator::forcePhase(std::string& error) {
     evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     tau_.setZero();
     if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
-    solver_->solve(model_, *data_, constraints_, *cdata_, q_, v_, tau_, u.res);
-    if (!u.res.ok) {
+    if (!solveDynamics(t_, q_, v_, tau_, u.res)) {
       error = "contact modes: " + u.res.error;
       return false;
     }
@@ -472,6 +547,61 @@ bool Simulator::forcePhase(std::string& error) {
     if (!r.was_closed && r.in_set) logEvent(ContactEventKind::Touchdown, k, r.gamma, 0, 0);
   }
   return true;
+}
+
+/// Friction modes at (t_, q_, v_), the normal modes decided: a closed
+/// contact that slips (an initial state sliding, or one whose impact left the
+/// cone) slides along its slip; a sticking one whose friction demand exceeds
+/// μ slides against its sticking force (−λₜ/|λₜ|: the friction it already
+/// exerts, at its limit); a sliding one at rest sticks if the cone allows.
+/// Repeated until no contact changes (each change moves the others' loads).
+bool Simulator::frictionPhase(std::string& error) {
+  auto& u = *uni_;
+  const ContactEventOptions& o = options_.contacts;
+  for (int it = 0;; ++it) {
+    if (it == o.max_mode_iterations) {
+      error = "friction modes: no consistent stick/slip set after " + std::to_string(it) + " passes";
+      return false;
+    }
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    tau_.setZero();
+    if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
+    if (!solveDynamics(t_, q_, v_, tau_, u.res)) {
+      error = "friction modes: " + u.res.error;
+      return false;
+    }
+    int change = -1;
+    for (int k = 0; k < static_cast<int>(u.rows.size()) && change < 0; ++k) {
+      UnilateralRow& r = u.rows[k];
+      if (r.nf == 0 || !cdata_->isActive(r.c)) continue;
+      const double fn = u.res.lambda[r.global];
+      if (cdata_->isSliding(r.c)) continue;
+      // Sticking rows' residuals are the slip (before any projection).
+      const RowBlock& blk = cdata_->blocks[r.c];
+      const auto& sr = cdata_->slide[r.c];
+      Vec3 slip = Vec3::Zero();
+      for (int i = 0; i < sr.n; ++i) {
+        const int row = sr.row[i];
+        double val = blk.b[row];
+        if (r.a >= 0) val += blk.Wa.row(row).dot(data_->oMi[r.a].act(data_->v[r.a]));
+        if (r.b >= 0) val -= blk.Wb.row(row).dot(data_->oMi[r.b].act(data_->v[r.b]));
+        slip[i] = val;
+      }
+      const Vec3 ft = frictionForce(k, u.res.lambda);
+      if (slip.norm() > o.speed_tol) {
+        r.dir = slip / slip.norm();
+      } else if (ft.norm() > r.mu * fn + o.force_tol && ft.norm() > 0) {
+        r.dir = -ft / ft.norm();
+      } else {
+        continue;
+      }
+      r.dir_start = r.dir;
+      cdata_->setSliding(r.c, true);
+      logEvent(ContactEventKind::Slip, k, 0, slip.norm(), 0);
+      change = k;
+    }
+    if (change < 0) return true;
+  }
 }
 
 /// Decides the mode of every touching unilateral constraint at (t_, q_, v_):

@@ -67,7 +67,9 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
       r.lifting = r.touching_down = false;
       cdata_->setActive(r.c, cdata_->gap[r.global] <= options_.contacts.gap_tol);
     }
-    if (!decideModes(state_error_)) state_error_ = "initial contact modes: " + state_error_;
+    if (!decideModes(state_error_) || !frictionPhase(state_error_))
+      state_error_ = "initial contact modes: " + state_error_;
+    for (auto& r : uni_->rows) r.dir_start = r.dir;
     integrator_->reset();
   }
   std::string error;
@@ -114,7 +116,7 @@ bool Simulator::evaluateEndState(std::string& error) {
     tau_.setZero();
     if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
     if (tau_.size() == model_.nv && tau_.allFinite()) {
-      solver_->solve(model_, *data_, constraints_, *cdata_, q_, v_, tau_, result_);
+      solveDynamics(t_, q_, v_, tau_, result_);
       if (!result_.ok) {
         error = result_.error;
         ok = false;
@@ -192,11 +194,13 @@ StepStatus Simulator::step(double h) {
   if (!evaluateEndState(error)) return fail(st, error);
   // Unilateral constraints: a gap or a normal force that changed sign over
   // the step means an event inside it (contact_events.cpp).
-  if (uni_ && options_.contacts.enabled && crossedConstraint() >= 0) {
+  detail::Crossing crossing = detail::Crossing::None;
+  if (uni_ && options_.contacts.enabled && crossedConstraint(crossing) >= 0) {
     st = locateAndHandleEvent(st, st.h_taken);
     if (!st.ok) return st;
   } else if (uni_) {
     uni_->zero_events = 0;
+    for (auto& r : uni_->rows) r.dir_start = r.dir;  // the next step's slip reference
   }
   ++counters_.steps;
   return st;

@@ -5,6 +5,9 @@
 
 #include <appell/simulator.hpp>
 
+#include <Eigen/LU>
+
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -32,8 +35,7 @@ class Simulator::Field final : public AccelerationField {
     if (s.options_.baumgarte.enabled)
       applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
                      s.options_.baumgarte.beta);
-    s.solver_->solve(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, tau_, stage_,
-                     SolveOutputs::Accelerations);
+    s.solveDynamics(t, q, v, tau_, stage_, SolveOutputs::Accelerations);
     if (!stage_.ok) {
       record(stage_.error, t);
       return false;
@@ -88,7 +90,16 @@ struct UnilateralRow {
   bool touching = false, in_set = false, was_closed = false, lifting = false, touching_down = false;
   bool bounced = false;   // rebounded at this event: open, not a force candidate
   double gap_start = 0;   // gap at the start of the step (open contacts)
+  // Coulomb friction (friction.cpp): μ, and while sliding the slip direction
+  // in the friction rows' coordinates (unit; kept when the slip is ~0).
+  double mu = std::numeric_limits<double>::infinity();
+  int nf = 0;             // friction rows (0: frictionless or bilateral)
+  Vec3 dir = Vec3::Zero();
+  Vec3 dir_start = Vec3::Zero();  // at the step's start: the slip-reversal event's reference
 };
+
+/// What a unilateral constraint's crossing is (the event function located).
+enum class Crossing { None, Gap, Normal, Cone, Slip };
 
 struct UnilateralState {
   std::vector<UnilateralRow> rows;
@@ -96,6 +107,13 @@ struct UnilateralState {
   double t0 = 0;
   ConstrainedResult res;
   int zero_events = 0;    // consecutive events at the very start of a step
+  // Sliding friction by superposition (friction.cpp), sized for every
+  // contact with friction rows and finite μ.
+  std::vector<int> sliding;   // rows (indices into `rows`) sliding in this solve
+  MatX G, J, R;               // nv × k friction forces per unit normal load; 6 × nv; k × k
+  VecX lam0, s, tau_f;
+  ConstrainedResult unit;
+  Eigen::PartialPivLU<MatX> lu;
 };
 
 }  // namespace detail

@@ -27,6 +27,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   for (size_t c = 0; c < constraints.size(); ++c) {
     const Constraint& con = *constraints[c];
     ws.names.push_back(con.name());
+    ws.unilateral_row.push_back(con.unilateralRow());
     const int rows = con.rows();
     const int A = con.bodyA(), B = con.bodyB();
     auto fail = [&](const std::string& why) {
@@ -114,12 +115,23 @@ void checkSizes(const Model& model, const ConstraintData& cdata, const detail::T
 }
 
 /// The active set of this solve: an open constraint's block writes no rows
-/// (its λ stays 0); an open loop row is a zero row of the Schur complement,
-/// not counted as redundant. Returns the open loop rows.
-int applyActiveSet(const ConstraintData& cdata, detail::TreeWorkspace& ws) {
-  for (auto& tb : ws.blocks) tb.rows = cdata.isActive(tb.constraint) ? tb.declared : 0;
+/// (its λ stays 0); an open loop row is a zero row of the Schur complement.
+/// A sliding constraint keeps its block, whose friction rows are zero rows
+/// (dropped by the compression, λ = 0). Zero rows are not redundancy:
+/// returns how many the loops hold and sets `zero_block_rows`.
+int applyActiveSet(const ConstraintData& cdata, detail::TreeWorkspace& ws, int& zero_block_rows) {
+  zero_block_rows = 0;
+  for (auto& tb : ws.blocks) {
+    tb.rows = cdata.isActive(tb.constraint) ? tb.declared : 0;
+    if (tb.rows > 0 && cdata.isSliding(tb.constraint)) zero_block_rows += tb.rows - 1;
+  }
   int open = 0;
-  for (const auto& lr : ws.loops) open += cdata.isActive(lr.constraint) ? 0 : 1;
+  for (const auto& lr : ws.loops) {
+    const bool zero = !cdata.isActive(lr.constraint) ||
+                      (cdata.isSliding(lr.constraint) &&
+                       lr.row != ws.unilateral_row[lr.constraint]);
+    open += zero ? 1 : 0;
+  }
   return open;
 }
 
@@ -142,7 +154,8 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   (void)constraints;
   auto& ws = *ws_;
   checkSizes(model, cdata, ws);
-  const int open_loops = applyActiveSet(cdata, ws);
+  int zero_rows = 0;
+  const int open_loops = applyActiveSet(cdata, ws, zero_rows);
   if (out.vdot.size() != model.nv) out.vdot.resize(model.nv);
   if (out.lambda.size() != ws.m) out.lambda.resize(ws.m);
   if (out.reaction.size() != model.nv) out.reaction.resize(model.nv);
@@ -181,10 +194,10 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   }
   ws.redundant += static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank;
   out.vdot = ws.vdot;
-  out.redundant = ws.redundant;
-  out.rank = cdata.m_active - ws.redundant;
+  out.redundant = ws.redundant - zero_rows;
+  out.rank = cdata.m_active - out.redundant;
   if (outputs == SolveOutputs::Accelerations) return;  // an integrator stage: v̇ is all it reads
-  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);
+  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);  // zero rows too: their λ = 0
   out.lambda = ws.lambda;
   detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
 }
@@ -194,7 +207,8 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
   (void)constraints;
   auto& ws = *ws_;
   checkSizes(model, cdata, ws);
-  const int open_loops = applyActiveSet(cdata, ws);
+  int zero_rows = 0;
+  const int open_loops = applyActiveSet(cdata, ws, zero_rows);
   ws.last_error.clear();
   if (cdata.singular) {
     ws.last_error = "singular constraint geometry: " + cdata.singular_reason;

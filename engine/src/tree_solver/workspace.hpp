@@ -234,6 +234,7 @@ struct Failure {
 };
 
 struct TreeWorkspace {
+  std::vector<int> unilateral_row;          ///< per constraint: Constraint::unilateralRow()
   SolverOptions options;
   int nbodies = 0, nv = 0, m = 0;
   std::vector<Node> nodes;

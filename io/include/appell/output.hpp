@@ -17,7 +17,8 @@
 //                      unilateral constraints (contacts, limits) also:
 //                      closed:<c>   1 closed, 0 open (lifted off, in flight)
 //                      event:<c>    the event at this sample's time: 0 none,
-//                                   1 touchdown, 2 bounce, 3 lift-off
+//                                   1 touchdown, 2 bounce, 3 lift-off,
+//                                   4 slip, 5 stick
 //                                   (1 + ContactEventKind, contact_events.hpp)
 // A step that ends at an event is always written, so each event is a row.
 // Numbers are written in the shortest form that reads back to the same double.

@@ -1,0 +1,119 @@
+// Coulomb friction of sliding contacts, by superposition of solves.
+//
+// A sliding contact j keeps its normal row; its friction rows are replaced by
+// the force −μⱼ λₙⱼ ŝⱼ at the contact point against the slip direction ŝⱼ
+// (docs/contacts.md §8). The force's direction is not its row's, so the
+// system M v̇ + h = τ + Aᵀλ + Σⱼ λₙⱼ gⱼ is no longer symmetric — but for a
+// fixed state it is affine in the applied joint forces, for every
+// formulation (v̇ and the minimum-norm λ alike). With gⱼ = J_jᵀ wⱼ the
+// generalized force of the unit-normal-load friction wrench wⱼ = −μⱼ Wⱼᵀŝⱼ
+// (Wⱼ: the friction rows' covectors, i.e. the point-force directions at the
+// contact), one solve at τ gives λₙ⁰ and one at τ + gⱼ per sliding contact the
+// response Rᵢⱼ = λₙᵢ(τ + gⱼ) − λₙᵢ⁰, so the normal loads solve
+//     (1 − R) λₙ = λₙ⁰,
+// and the final solve at τ + Σ λₙⱼ gⱼ is exact: k + 2 solves for k sliding
+// contacts, O(k n) with the tree solver (the Schur complement on top of its
+// passes the friction issue asks for). A singular 1 − R, or a sliding normal
+// load that would pull, is a configuration with no consistent sliding mode
+// (Painlevé 1895; Pfeiffer & Glocker 1996, §7.4): reported with the contacts.
+#include <appell/kinematics.hpp>
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_internal.hpp"
+
+#include <cmath>
+
+namespace appell {
+
+using detail::UnilateralRow;
+
+/// The slip direction of a sliding contact from its rows' slip velocities.
+/// Within a step the slip never reverses (a reversal is an event that ends
+/// the step), so a stage state whose slip is below `floor` or points against
+/// the step's starting direction — a slip just starting from rest, where a
+/// stage's truncation error (O(h²ω²v) for a fast-spinning wheel) exceeds the
+/// slip itself — keeps the step's starting direction.
+static void slipDirection(const ConstraintData& cd, UnilateralRow& r, double floor) {
+  const auto& sr = cd.slide[r.c];
+  const auto slip = sr.slip.head(sr.n);
+  const double speed = slip.norm();
+  if (speed > floor && slip.dot(r.dir_start.head(sr.n)) > 0) r.dir.head(sr.n) = slip / speed;
+  else r.dir = r.dir_start;
+}
+
+bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX& tau,
+                              ConstrainedResult& out, SolveOutputs outputs) {
+  (void)t;
+  auto* u = uni_.get();
+  if (u) {
+    u->sliding.clear();  // capacity reserved: no allocation
+    for (int k = 0; k < static_cast<int>(u->rows.size()); ++k)
+      if (cdata_->isActive(u->rows[k].c) && cdata_->isSliding(u->rows[k].c)) u->sliding.push_back(k);
+  }
+  if (!u || u->sliding.empty()) {
+    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, outputs);
+    return out.ok;
+  }
+  const int k = static_cast<int>(u->sliding.size());
+  // Friction forces per unit normal load, from the rows' covectors (world
+  // spatial forces on A and B), with data_ at forwardKinematics(q, v).
+  for (int j = 0; j < k; ++j) {
+    UnilateralRow& r = u->rows[u->sliding[j]];
+    slipDirection(*cdata_, r, 10 * options_.contacts.speed_tol);
+    const auto& sr = cdata_->slide[r.c];
+    const Vec3 f = -r.mu * r.dir;  // components along the friction rows
+    auto g = u->G.col(j);
+    g.setZero();
+    if (r.a >= 0) {
+      spatialJacobianWorld(model_, *data_, r.a, u->J);
+      g.noalias() += u->J.transpose() * (sr.Wa.topRows(sr.n).transpose() * f.head(sr.n));
+    }
+    if (r.b >= 0) {
+      spatialJacobianWorld(model_, *data_, r.b, u->J);
+      g.noalias() -= u->J.transpose() * (sr.Wb.topRows(sr.n).transpose() * f.head(sr.n));
+    }
+  }
+  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, SolveOutputs::All);
+  if (!out.ok) return false;
+  for (int i = 0; i < k; ++i) u->lam0[i] = out.lambda[u->rows[u->sliding[i]].global];
+  for (int j = 0; j < k; ++j) {
+    u->tau_f = tau + u->G.col(j);
+    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u->tau_f, u->unit, SolveOutputs::All);
+    if (!u->unit.ok) {
+      out.ok = false;
+      out.error = u->unit.error;
+      return false;
+    }
+    for (int i = 0; i < k; ++i)
+      u->R(i, j) = (i == j ? 1.0 : 0.0) - (u->unit.lambda[u->rows[u->sliding[i]].global] - u->lam0[i]);
+  }
+  auto fail = [&](const char* why) {
+    out.ok = false;
+    out.error = std::string("sliding friction: ") + why + " at contacts";
+    for (int j = 0; j < k; ++j) out.error += " '" + constraints_[u->rows[u->sliding[j]].c]->name() + "'";
+    out.error += " (a Painlevé-type configuration: no consistent sliding mode)";
+    return false;
+  };
+  // (1 − R) λₙ = λₙ⁰ on the leading k × k block (storage sized once).
+  u->lu.compute(u->R.topLeftCorner(k, k));
+  if (!(std::abs(u->lu.determinant()) > 1e-12)) return fail("the normal loads are not determined");
+  u->s.head(k) = u->lu.solve(u->lam0.head(k));
+  if (!u->s.head(k).allFinite()) return fail("the normal loads are not finite");
+  u->tau_f = tau;
+  for (int j = 0; j < k; ++j) u->tau_f.noalias() += u->s[j] * u->G.col(j);
+  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u->tau_f, out, outputs);
+  if (!out.ok) return false;
+  if (outputs == SolveOutputs::All) {
+    // Report the friction force on the friction rows' multipliers: the
+    // force along each row's direction, as for a sticking contact.
+    for (int j = 0; j < k; ++j) {
+      const UnilateralRow& r = u->rows[u->sliding[j]];
+      const auto& sr = cdata_->slide[r.c];
+      for (int i = 0; i < sr.n; ++i)
+        out.lambda[cdata_->offset[r.c] + sr.row[i]] = -r.mu * u->s[j] * r.dir[i];
+    }
+  }
+  return true;
+}
+
+}  // namespace appell

@@ -1,0 +1,136 @@
+// Coulomb friction at unilateral contacts (docs/contacts.md §8): stick and
+// slip modes, their transitions as events, and the sliding dynamics against
+// closed forms for a homogeneous ball (m, r, I = 2/5 m r²) on a plane.
+#include <gtest/gtest.h>
+
+#include <appell/simulator.hpp>
+
+#include "ball.hpp"
+
+#include <cmath>
+
+using namespace appell;
+using namespace appell::scenes;
+
+namespace {
+
+constexpr double kG = 9.81, kM = 0.5, kR = 0.1;
+
+IntegratorOptions tight() {
+  IntegratorOptions o;
+  o.rtol = 1e-12;
+  o.atol = 1e-12;
+  o.h_max = 0.01;
+  return o;
+}
+
+/// A ball on the plane z = 0 with friction μ, centre velocity vG and world
+/// angular velocity ω (not necessarily rolling), under gravity `g`.
+BuiltScene ballWithFriction(double mu, const Vec3& vG, const Vec3& omega, const Vec3& g) {
+  BallParams p;
+  p.radius = kR;
+  p.mass = kM;
+  BuiltScene s = ball(p);
+  ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+  spec.mu = mu;
+  s.constraints[0] = makeContact(spec);
+  s.model.gravity = g;
+  s.v0 = floatingVelocity(Mat3::Identity(), omega, vG);
+  return s;
+}
+
+Vec3 centreVelocity(const Simulator& sim) { return floatingRotation(sim.q(), 0) * Vec3(sim.v().tail<3>()); }
+Vec3 angularVelocity(const Simulator& sim) { return floatingRotation(sim.q(), 0) * Vec3(sim.v().head<3>()); }
+
+std::vector<ContactEvent> advance(Simulator& sim, double t_end, double h = 1e-2) {
+  std::vector<ContactEvent> all(sim.events().begin(), sim.events().end());
+  while (sim.time() < t_end - 1e-12) {
+    const StepStatus st = sim.step(std::min(h, t_end - sim.time()));
+    EXPECT_TRUE(st.ok) << st.message;
+    if (!st.ok) break;
+    all.insert(all.end(), sim.events().begin(), sim.events().end());
+  }
+  return all;
+}
+
+}  // namespace
+
+// Protects: slip → stick. A ball launched sliding at v₀ without spin slides
+// with a = −μg, ω̇ = 5μg/(2r) until v = rω, at t* = 2v₀/(7μg); then it rolls
+// at 5v₀/7 (the classic billiard result), in every formulation.
+TEST(ContactFriction, SlidingBallStartsRollingAtFiveSevenths) {
+  const double mu = 0.2, v0 = 2.0, t_star = 2 * v0 / (7 * mu * kG);
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    BuiltScene s = ballWithFriction(mu, Vec3(v0, 0, 0), Vec3::Zero(), Vec3(0, 0, -kG));
+    Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                  IntegratorType::DormandPrince54, tight());
+    ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+    ASSERT_TRUE(sim.constraintData().isSliding(0)) << "an initial state that slips starts sliding";
+    const auto events = advance(sim, 0.5 * t_star);
+    EXPECT_NEAR(centreVelocity(sim).x(), v0 - mu * kG * sim.time(), 1e-9) << toString(f);
+    EXPECT_NEAR(angularVelocity(sim).y(), 5 * mu * kG / (2 * kR) * sim.time(), 1e-8) << toString(f);
+    EXPECT_NEAR(sim.lambda().head<2>().norm(), mu * kM * kG, 1e-9) << "the friction force on the tangent rows";
+    EXPECT_NEAR((sim.lambda()[0] * sim.contactFrame(0).t1 + sim.lambda()[1] * sim.contactFrame(0).t2).x(),
+                -mu * kM * kG, 1e-9) << "against the slip";
+    EXPECT_NEAR(sim.lambda()[2], kM * kG, 1e-9);
+    const auto later = advance(sim, 2 * t_star);
+    ASSERT_EQ(later.size(), 1u) << toString(f);
+    EXPECT_EQ(later[0].kind, ContactEventKind::Stick);
+    EXPECT_NEAR(later[0].t, t_star, 1e-10) << toString(f);
+    EXPECT_FALSE(sim.constraintData().isSliding(0));
+    EXPECT_NEAR(centreVelocity(sim).x(), 5 * v0 / 7, 1e-9) << toString(f);
+    EXPECT_LT(sim.velocityResidual(), 1e-12);
+  }
+}
+
+// Protects: stick → slip located where the friction demand reaches μλₙ. A
+// rolling ball pushed at its centre by F = kt needs the friction (2/7)F, so
+// it slips at t* = 7μmg/(2k); sliding, a = (F − μmg)/m. (Adaptive steps:
+// with fixed RK4 steps the slip just after onset, O(h²) small, is below the
+// stages' truncation error for a ball spinning at 60 rad/s, and its
+// direction is noise — docs/contacts.md §8.)
+TEST(ContactFriction, PushedBallSlipsWhenTheDemandReachesMu) {
+  const double mu = 0.3, k = 4.0, t_star = 7 * mu * kM * kG / (2 * k);
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    for (IntegratorType it : {IntegratorType::DormandPrince54}) {
+      BuiltScene s = ballWithFriction(mu, Vec3::Zero(), Vec3::Zero(), Vec3(0, 0, -kG));
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, tight());
+      sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
+        tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
+      });
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+      const auto events = advance(sim, t_star + 0.2);
+      ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it);
+      EXPECT_EQ(events[0].kind, ContactEventKind::Slip);
+      EXPECT_NEAR(events[0].t, t_star, 1e-10) << toString(f) << " " << toString(it);
+      // Rolling until t*: v = (5/7) k t²/(2m); then a = (kt − μmg)/m.
+      const double t = sim.time(), vs = 5.0 / 7 * k * t_star * t_star / (2 * kM);
+      const double v = vs + (k * (t * t - t_star * t_star) / 2 - mu * kM * kG * (t - t_star)) / kM;
+      EXPECT_NEAR(centreVelocity(sim).x(), v, 1e-8) << toString(f) << " " << toString(it);
+      EXPECT_NEAR(sim.lambda().head<2>().norm(), mu * kM * kG, 1e-9);
+    }
+  }
+}
+
+// Protects: the friction angle. On an incline of angle α a ball rolls
+// (sticks) when tan α ≤ (7/2)μ, with a = (5/7)g sin α; above it slides from
+// rest with a = g(sin α − μ cos α) and ω̇ = 5μg cos α/(2r).
+TEST(ContactFriction, BallOnAnInclineRollsBelowTheFrictionAngleAndSlidesAbove) {
+  const double mu = 0.1;
+  for (double alpha : {0.3, 0.45}) {  // tan: 0.31 < 0.35 rolls; 0.48 > 0.35 slides
+    const Vec3 g(kG * std::sin(alpha), 0, -kG * std::cos(alpha));  // the plane tilted: gravity tilted
+    for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
+      BuiltScene s = ballWithFriction(mu, Vec3::Zero(), Vec3::Zero(), g);
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                    IntegratorType::DormandPrince54, tight());
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+      const bool slides = std::tan(alpha) > 3.5 * mu;
+      EXPECT_EQ(sim.constraintData().isSliding(0), slides) << "alpha " << alpha;
+      advance(sim, 0.5);
+      const double a = slides ? kG * (std::sin(alpha) - mu * std::cos(alpha)) : 5.0 / 7 * kG * std::sin(alpha);
+      EXPECT_NEAR(centreVelocity(sim).x(), a * sim.time(), 1e-9) << "alpha " << alpha << " " << toString(f);
+      const double wdot = slides ? 5 * mu * kG * std::cos(alpha) / (2 * kR) : a / kR;
+      EXPECT_NEAR(angularVelocity(sim).y(), wdot * sim.time(), 1e-8) << "alpha " << alpha;
+    }
+  }
+}
