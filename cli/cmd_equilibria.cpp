@@ -31,7 +31,7 @@ scene's initial configuration and from random perturbations of it.
 
 int equilibria(int argc, char** argv) {
   Args args(argc, argv, 2, {"starts", "spread", "seed", "tol", "package-path"},
-            {"help", "project-initial"});
+            {"help", "project-initial", "no-joint-limits"});
   if (args.has("help")) {
     std::cout << kHelp;
     return 0;

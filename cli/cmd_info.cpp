@@ -14,7 +14,7 @@ namespace appell::cli {
 
 namespace {
 
-const char* kHelp = R"(usage: appell info SCENE.urdf [--package-path DIRS] [--project-initial]
+const char* kHelp = R"(usage: appell info SCENE.urdf [--package-path DIRS] [--project-initial] [--no-joint-limits]
 
 Prints the bodies (joint type, parent, mass), the degrees of freedom (nq, nv),
 every contact with its kind, support, shape and rows, and at the initial state
@@ -54,6 +54,12 @@ int info(int argc, char** argv) {
     std::cout << ", rows:";
     for (int r = 0; r < c.rows(); ++r) std::cout << " " << c.rowLabel(r);
     std::cout << "\n";
+  }
+  if (!scene.joint_limits.empty()) {
+    std::cout << scene.joint_limits.size() << " joint limits (unilateral; --no-joint-limits ignores them):\n";
+    for (const auto& l : scene.joint_limits)
+      std::cout << "  " << std::setw(22) << l->name() << " " << (l->side() == LimitSide::Lower ? "q ≥ " : "q ≤ ")
+                << l->bound() << ", restitution " << l->restitution() << "\n";
   }
   if (scene.constraintRows() > 0) {
     Data data(m);

@@ -36,7 +36,7 @@ Exit status 3 when the reference is not an equilibrium / steady motion.
 
 int linearize(int argc, char** argv) {
   Args args(argc, argv, 2, {"cyclic", "formulation", "zero-tol", "package-path"},
-            {"help", "equilibrium", "project-initial"});
+            {"help", "equilibrium", "project-initial", "no-joint-limits"});
   if (args.has("help")) {
     std::cout << helpText(kHelp);
     return 0;

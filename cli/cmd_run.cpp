@@ -31,6 +31,9 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
   --no-projection     do not project onto the constraints after each step
   --package-path DIRS colon/comma-separated folders for package:// meshes
   --project-initial   project an initial state that violates the constraints
+  --no-joint-limits   ignore the URDF position limits of revolute and prismatic
+                      joints (by default each finite one is a unilateral
+                      constraint: the joint stops or bounces there)
   --quiet             no progress bar
 
 Exit status: 0 success, 1 bad input, 2 usage, 3 the simulation failed (the
@@ -159,7 +162,7 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path"},
-            {"project-initial", "help", "no-projection", "quiet", "plot"});
+            {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kHelp);
     return 0;

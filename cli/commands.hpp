@@ -16,7 +16,7 @@ int plot(int argc, char** argv);
 
 /// Options every command that loads a scene accepts.
 inline const std::set<std::string> kLoadOptions = {"package-path"};
-inline const std::set<std::string> kLoadFlags = {"project-initial", "help"};
+inline const std::set<std::string> kLoadFlags = {"project-initial", "no-joint-limits", "help"};
 
 /// Loads the scene named by the single positional argument.
 Scene loadFromArgs(const Args& args, bool check_initial = true);

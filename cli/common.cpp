@@ -14,6 +14,7 @@ Scene loadFromArgs(const Args& args, bool check_initial) {
   for (const std::string& p : args.list("package-path")) opt.package_paths.push_back(p);
   opt.check_initial_state = check_initial;
   opt.project_initial_state = args.has("project-initial");
+  opt.joint_limits = !args.has("no-joint-limits");
   return loadScene(args.positional()[0], opt);
 }
 

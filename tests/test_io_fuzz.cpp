@@ -65,7 +65,7 @@ TEST(IoFuzz, DamagedFilesGiveSceneErrorsOnly) {
         // A scene that loads is whole: state sizes match the model.
         EXPECT_EQ(s.q0.size(), s.model.nq);
         EXPECT_EQ(s.v0.size(), s.model.nv);
-        EXPECT_EQ(s.constraints.size(), s.contacts.size());
+        EXPECT_EQ(s.constraints.size(), s.contacts.size() + s.joint_limits.size());
         EXPECT_EQ(static_cast<int>(s.geometry.size()), s.model.nbodies);
         ++loaded;
       } catch (const SceneError& e) {

@@ -10,6 +10,7 @@
 #include <appell/constraint.hpp>
 #include <appell/constraint_set.hpp>
 #include <appell/contacts.hpp>
+#include <appell/joint_limit.hpp>
 #include <appell/model.hpp>
 
 #include <array>
@@ -84,13 +85,18 @@ struct SimulationSettings {
 
 struct Scene {
   Model model;
-  /// One constraint per contact, in the order of `contacts`.
+  /// One constraint per contact, in the order of `contacts`, then the joint
+  /// limits, in the order of `joint_limits`.
   ConstraintList constraints;
   /// The declared contacts in document order: the same objects as `constraints`
   /// (a contact's description is its spec(); the link is
   /// model.body_names[contact->bodyA()]).
   std::vector<std::shared_ptr<const ShapeContact>> contacts;
   std::vector<ContactOrigin> contact_origins;  ///< index-aligned with `contacts`
+  /// URDF <limit lower upper> of revolute and prismatic joints, one per finite
+  /// side (joint_limit.hpp; off with LoadOptions::joint_limits = false): the
+  /// same objects as constraints[contacts.size() …].
+  std::vector<std::shared_ptr<const JointLimit>> joint_limits;
   std::vector<Support> supports;
   VecX q0, v0;                     ///< initial state (nq, nv)
   VecX tau;                        ///< constant generalized forces (nv), from <effort>

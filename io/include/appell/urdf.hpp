@@ -38,6 +38,9 @@ struct LoadOptions {
   /// when `project_initial_state` is set.
   bool check_initial_state = true;
   bool project_initial_state = false;
+  /// Enforce the URDF position limits of revolute and prismatic joints as
+  /// unilateral constraints (Scene::joint_limits); false ignores them.
+  bool joint_limits = true;
   double initial_state_tolerance = 1e-8;
 };
 

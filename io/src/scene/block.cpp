@@ -287,13 +287,25 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
     } else if (tag == "effort") {
       allowOnly(src, e, {"joint", "value"});
       b.efforts.push_back({e, text(src, e, "joint"), numbers(src, e, "value")});
+    } else if (tag == "joint_limits") {
+      allowOnly(src, e, {"enabled", "restitution"});
+      if (b.limits_element) fail(src, e, "<joint_limits> is given twice");
+      b.limits_element = e;
+      const std::string en = text(e, "enabled", "true");
+      if (en != "true" && en != "false") fail(src, e, "'enabled' must be \"true\" or \"false\"");
+      b.limits_enabled = en == "true";
+      if (has(e, "restitution")) {
+        b.limits_restitution = number(src, e, "restitution");
+        if (!(b.limits_restitution >= 0 && b.limits_restitution <= 1))
+          fail(src, e, "restitution must lie in [0, 1] (0: plastic, 1: elastic)");
+      }
     } else if (tag == "simulation") {
       if (have_simulation) fail(src, e, "<simulation> is given twice");
       have_simulation = true;
       b.settings = parseSimulation(src, e);
     } else {
       fail(src, e, "unknown element <" + tag +
-                       "> in <appell> (known: gravity, support, contact, initial, effort, simulation)");
+                       "> in <appell> (known: gravity, support, contact, initial, effort, joint_limits, simulation)");
     }
   }
   for (const ContactDecl& c : b.contacts)

@@ -50,6 +50,10 @@ struct AppellBlock {
   std::vector<JointStateDecl> initial;
   std::vector<EffortDecl> efforts;
   SimulationSettings settings;
+  /// <joint_limits enabled="true|false" restitution="e"/>
+  const TiXmlElement* limits_element = nullptr;
+  bool limits_enabled = true;
+  double limits_restitution = 0;
 };
 
 /// Reads the <appell> child of <robot> (if any). Throws SceneError.
@@ -58,6 +62,7 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
 
 /// Turns the declarations into the scene's supports, contacts, constraints,
 /// initial state and efforts, against the built model and link geometry.
-void buildSceneContents(const XmlSource& src, const AppellBlock& block, Scene& scene);
+void buildSceneContents(const XmlSource& src, const AppellBlock& block, const LoadOptions& options,
+                        Scene& scene);
 
 }  // namespace appell::io

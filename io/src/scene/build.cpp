@@ -4,6 +4,7 @@
 
 #include <appell/configuration.hpp>
 
+#include <cmath>
 #include <sstream>
 
 namespace appell::io {
@@ -122,7 +123,8 @@ void setJointState(const XmlSource& src, const Model& model, const JointStateDec
 
 }  // namespace
 
-void buildSceneContents(const XmlSource& src, const AppellBlock& block, Scene& scene) {
+void buildSceneContents(const XmlSource& src, const AppellBlock& block, const LoadOptions& options,
+                        Scene& scene) {
   const Model& model = scene.model;
   for (const SupportDecl& d : block.supports) {
     Support support = d.support;
@@ -156,6 +158,19 @@ void buildSceneContents(const XmlSource& src, const AppellBlock& block, Scene& s
     scene.constraints.push_back(contact);
     scene.contacts.push_back(std::move(contact));
     scene.contact_origins.push_back(std::move(origin));
+  }
+  if (block.limits_enabled && options.joint_limits) {
+    for (int j = 0; j < model.nbodies; ++j) {
+      const Joint& joint = model.joints[j];
+      if (joint.type != JointType::Revolute && joint.type != JointType::Prismatic) continue;
+      for (LimitSide side : {LimitSide::Lower, LimitSide::Upper}) {
+        const double bound = side == LimitSide::Lower ? joint.limits.lower : joint.limits.upper;
+        if (!std::isfinite(bound)) continue;
+        auto limit = std::make_shared<const JointLimit>(model, j, side, block.limits_restitution);
+        scene.constraints.push_back(limit);
+        scene.joint_limits.push_back(std::move(limit));
+      }
+    }
   }
   scene.q0 = neutralConfiguration(model);
   scene.v0 = VecX::Zero(model.nv);

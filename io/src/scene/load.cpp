@@ -20,7 +20,7 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   scene.model = std::move(parsed.model);
   scene.geometry = std::move(parsed.geometry);
   scene.source = name;
-  io::buildSceneContents(src, block, scene);
+  io::buildSceneContents(src, block, options, scene);
   if (options.check_initial_state)
     checkInitialState(scene, options.project_initial_state, options.initial_state_tolerance);
   return scene;
