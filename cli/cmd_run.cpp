@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <atomic>
+#include <csignal>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -36,7 +38,9 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
                       constraint: the joint stops or bounces there)
   --quiet             no progress bar
 
-Exit status: 0 success, 1 bad input, 2 usage, 3 the simulation failed (the
+Exit status: 0 success, 1 bad input or an output that could not be written,
+130 interrupted (SIGINT: the summary and the trajectory up to the state reached
+are written), 2 usage, 3 the simulation failed (the
 summary says why and at what time; the trajectory up to there is written).
 )";
 
@@ -187,6 +191,16 @@ int run(int argc, char** argv) {
   if (options.output_every < 1) throw UsageError("option --every must be at least 1");
   options.project_positions = options.project_velocities = !args.has("no-projection");
 
+  // SIGINT stops the run after the current step: the state reached is written
+  // and flushed, the summary printed, and the exit status is 130.
+  static std::atomic<bool> interrupted{false};
+  interrupted = false;
+  options.stop = &interrupted;
+  struct SigintGuard {
+    void (*previous)(int);
+    SigintGuard() : previous(std::signal(SIGINT, [](int) { interrupted = true; })) {}
+    ~SigintGuard() { std::signal(SIGINT, previous); }
+  } sigint_guard;
   Progress progress(options.duration, !args.has("quiet"));
   auto on_step = [&](const Simulator& sim) { progress.update(sim.time()); };
   RunSummary summary;
@@ -203,13 +217,25 @@ int run(int argc, char** argv) {
   progress.done();
 
   printSummary(std::cout, scene, summary);
-  if (writer) std::cout << "trajectory   " << args.text("out") << " (" << writer->samples() << " rows, "
-                        << writer->columns().size() << " columns)\n";
+  if (summary.interrupted)
+    std::cout << "interrupted  at t = " << summary.time << " s (SIGINT): the summary and the trajectory "
+              << "end there\n";
+  if (writer) {
+    csv.flush();
+    // Every write is checked here, once: a full disk or a closed pipe is an
+    // error naming the file, never a silent short trajectory.
+    if (!csv) throw std::runtime_error("writing the trajectory '" + args.text("out") +
+                                       "' failed (disk full or not writable): " +
+                                       std::to_string(writer->samples()) + " rows were not all written");
+    std::cout << "trajectory   " << args.text("out") << " (" << writer->samples() << " rows, "
+              << writer->columns().size() << " columns)\n";
+  }
   if (args.has("plot")) {
     csv.close();
     for (const std::string& png : writePlots(args.text("out"), defaultPlotDir(args.text("out")), &scene))
       std::cout << "plot         " << png << "\n";
   }
+  if (summary.interrupted) return 130;  // 128 + SIGINT, as a shell reports it
   return summary.ok ? 0 : 3;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cstring>
 #include <iostream>
+#include <new>
 
 namespace {
 
@@ -41,8 +42,14 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::cerr << "appell " << cmd << ": " << e.what() << " (see appell " << cmd << " --help)\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "appell " << cmd << ": error: out of memory (the scene or its meshes are too large)\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "appell " << cmd << ": error: " << e.what() << "\n";
+    return 1;
+  } catch (...) {
+    std::cerr << "appell " << cmd << ": internal error: an unknown exception\n";
     return 1;
   }
 }

@@ -2,6 +2,7 @@
 // problem, and a run whose summary reports conserved energy.
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
+#include <appell/trajectory_reader.hpp>
 
 #include "run_command.hpp"
 
@@ -9,7 +10,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
+
+#include <unistd.h>
 #include <regex>
 #include <string>
 
@@ -118,4 +123,32 @@ TEST(Cli, EquilibriumOfTheUprightDisk) {
   EXPECT_NE(r.output.find("1 distinct equilibria found"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("local dimension of the equilibrium set: 4"), std::string::npos) << r.output;
   EXPECT_NEAR(field(r.output, R"(rim/normal\s+([-+0-9.e]+))"), 9.81, 1e-9) << r.output;
+}
+
+// Output that fails loudly: a trajectory that cannot be written is an error
+// naming the file (exit 1), never "trajectory … (N rows)" and status 0.
+TEST(Cli, UnwritableTrajectoryIsAnError) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+  const Result r = sh("run " + kDisk + " --duration 0.5 --quiet --out /dev/full");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("writing the trajectory '/dev/full' failed"), std::string::npos) << r.output;
+}
+
+// SIGINT stops a run cleanly: the summary so far is printed, the trajectory
+// ends with a whole row at the state reached, and the status is 130.
+TEST(Cli, SigintFinishesTheRowPrintsTheSummaryAndExits130) {
+  const std::string csv = std::string(APPELL_BINARY_DIR) + "/cli_sigint_" + std::to_string(getpid()) + ".csv";
+  const appell::test::CommandResult r = appell::test::runCommand(
+      "timeout --preserve-status -s INT 1 " + std::string(APPELL_BINARY_DIR) + "/cli/appell run " + kDisk +
+      " --duration 100000 --quiet --out " + csv);
+  EXPECT_EQ(r.status, 130) << r.output;
+  EXPECT_NE(r.output.find("interrupted  at t = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("energy       E0 = "), std::string::npos) << "the summary so far";
+  std::ifstream in(csv);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(text.size(), 100u);
+  EXPECT_EQ(text.back(), '\n') << "the last row is whole";
+  const appell::TrajectoryTable t = appell::readTrajectory(csv);  // every row parses
+  EXPECT_GT(t.rows.size(), 10u);
+  std::filesystem::remove(csv);
 }

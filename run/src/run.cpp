@@ -139,6 +139,11 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     const bool sampled = step % options.output_every == 0 || !sim.events().empty();
     if (on_sample && sampled) on_sample(sim);
     last_sampled = sampled;
+    if (options.stop && options.stop->load()) {
+      s.interrupted = true;
+      if (on_step) on_step(sim);
+      break;
+    }
     if (on_step) on_step(sim);
   }
   s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -33,6 +33,7 @@
 #include <appell/scene.hpp>
 #include <appell/simulator.hpp>
 
+#include <atomic>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -50,6 +51,10 @@ struct RunOptions {
   bool project_positions = true;   ///< Newton on the holonomic gaps after every step
   bool project_velocities = true;  ///< impulse solve after every step
   int output_every = 1;            ///< the observer sees every N-th step (N ≥ 1)
+  /// Polled after every step: when it reads true the run stops there (a
+  /// clean stop: the state reached is sampled, the summary says so). For a
+  /// SIGINT handler or another thread; null: never.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// The scene's own settings as run options. Throws std::invalid_argument for
@@ -87,6 +92,7 @@ struct RunSummary {
   RunOptions options;
   bool ok = true;                  ///< every step succeeded
   std::string failure;             ///< why the run stopped (empty when ok)
+  bool interrupted = false;        ///< stopped early by RunOptions::stop (still ok)
   double time = 0;                 ///< time reached (of the last good state when !ok)
   SimulatorCounters counters;
   int partition_changes = 0;       ///< re-choices of the Appell velocity partition
