@@ -5,7 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <regex>
+
+#include <unistd.h>
 
 using namespace appell;
 
@@ -148,4 +153,62 @@ TEST(IoErrors, RestitutionOutsideZeroOneNamesTheContact) {
 
 TEST(IoErrors, UnilateralMustBeTrueOrFalse) {
   expectError("unilateral_value.urdf", 6, {"<contact name=\"foot\">", "'unilateral' must be \"true\""});
+}
+
+// Bounded reading (issue 17): what is not a scene file is named as such,
+// never read until memory runs out or parsed into "document empty".
+TEST(IoErrors, DevicesDirectoriesAndUtf16AreNamed) {
+  auto message = [](const std::string& path) {
+    try {
+      loadScene(path);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  if (std::filesystem::exists("/dev/zero"))
+    EXPECT_NE(message("/dev/zero").find("/dev/zero: not a regular file"), std::string::npos);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  EXPECT_NE(message(dir.string()).find("is a directory"), std::string::npos);
+  const std::string u16 = (dir / ("appell_u16_" + std::to_string(::getpid()) + ".urdf")).string();
+  {
+    std::ofstream out(u16, std::ios::binary);
+    const char bytes[] = {'\xff', '\xfe', '<', 0, 'r', 0, 'o', 0};
+    out.write(bytes, sizeof bytes);
+  }
+  EXPECT_NE(message(u16).find("UTF-16"), std::string::npos) << message(u16);
+  std::filesystem::remove(u16);
+}
+
+TEST(IoErrors, DeepNestingLongValuesAndHugeNumbersAreNamed) {
+  auto message = [](const std::string& xml) {
+    try {
+      loadSceneFromString(xml, ".", "gen.urdf");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  // 10⁵ levels: refused before the (recursive) parser sees them.
+  std::string deep = "<robot name=\"r\">";
+  for (int i = 0; i < 100000; ++i) deep += "<a>";
+  for (int i = 0; i < 100000; ++i) deep += "</a>";
+  deep += "</robot>";
+  EXPECT_NE(message(deep).find("nested more than 256 deep"), std::string::npos);
+  // A 2 MB link name is clipped in the message.
+  const std::string base = std::string(APPELL_SOURCE_DIR) + "/tests/data/io/bad/initial_violation.urdf";
+  std::ifstream in(base);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string long_name = text;
+  long_name.replace(long_name.find("link=\"ball\" kind"), 11, "link=\"" + std::string(2000000, 'x') + "\"");
+  const std::string m = message(long_name);
+  EXPECT_LT(m.size(), 1000u) << "the message is short";
+  EXPECT_NE(m.find("(2000000 characters)"), std::string::npos) << m.substr(0, 300);
+  // 1e309 is out of the doubles' range, and said so.
+  std::string huge = text;
+  huge.replace(huge.find("<mass value=\"1\""), 15, "<mass value=\"1e309\"");
+  EXPECT_NE(message(huge).find("\"1e309\" is not finite (out of the range of doubles"), std::string::npos)
+      << message(huge);
+  // A file ending inside a UTF-8 sequence is malformed, nothing worse.
+  EXPECT_NE(message(text + "\xC3").find("gen.urdf"), std::string::npos);
 }

@@ -17,9 +17,62 @@
 
 namespace appell::io {
 
+/// The deepest element nesting of the text, counted without parsing (the
+/// parser recurses per level: a file nested 10⁵ deep would overflow its
+/// stack). Comments, CDATA, declarations and quoted attribute values are
+/// skipped; an error in them is left to the parser.
+static int nestingDepth(const std::string& xml, int limit) {
+  int depth = 0, deepest = 0;
+  const std::size_t n = xml.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (xml[i] != '<') continue;
+    if (xml.compare(i, 4, "<!--") == 0) {
+      const auto end = xml.find("-->", i + 4);
+      if (end == std::string::npos) break;
+      i = end + 2;
+      continue;
+    }
+    if (xml.compare(i, 9, "<![CDATA[") == 0) {
+      const auto end = xml.find("]]>", i + 9);
+      if (end == std::string::npos) break;
+      i = end + 2;
+      continue;
+    }
+    if (i + 1 < n && (xml[i + 1] == '?' || xml[i + 1] == '!')) continue;
+    const bool closing = i + 1 < n && xml[i + 1] == '/';
+    // Find the end of the tag, skipping quoted attribute values.
+    std::size_t j = i + 1;
+    char quote = 0;
+    for (; j < n; ++j) {
+      const char c = xml[j];
+      if (quote) {
+        if (c == quote) quote = 0;
+      } else if (c == '"' || c == '\'') {
+        quote = c;
+      } else if (c == '>') {
+        break;
+      }
+    }
+    if (j >= n) break;
+    if (closing) --depth;
+    else if (xml[j - 1] != '/') deepest = std::max(deepest, ++depth);
+    if (deepest > limit) return deepest;
+    i = j;
+  }
+  return deepest;
+}
+
 const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
                                   const std::string& xml) {
-  doc.Parse(xml.c_str(), nullptr, TIXML_ENCODING_UTF8);
+  constexpr int kMaxDepth = 256;  // a URDF is 3–4 levels deep
+  if (nestingDepth(xml, kMaxDepth) > kMaxDepth)
+    fail(src, "malformed XML: elements nested more than " + std::to_string(kMaxDepth) +
+                  " deep (a URDF needs 4)");
+  // TinyXML may look one byte past a truncated UTF-8 sequence at the very
+  // end: give it a copy padded with NULs.
+  std::string padded = xml;
+  padded.append(8, '\0');
+  doc.Parse(padded.c_str(), nullptr, TIXML_ENCODING_UTF8);
   if (doc.Error()) {
     std::string where = src.file;
     if (doc.ErrorRow() > 0)

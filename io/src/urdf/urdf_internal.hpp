@@ -7,6 +7,8 @@
 // (scene/block.cpp) reads its own child of the same DOM.
 #pragma once
 
+#include <cstdint>
+
 #include <appell/urdf.hpp>
 
 #include "urdf/xml_util.hpp"
@@ -75,7 +77,10 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
                  const LoadOptions& options, const Vec3& gravity);
 
 /// Whole file as a string; SceneError if it cannot be read.
+/// A scene file's text; refuses directories, devices, files over
+/// kMaxSceneBytes, UTF-16/32 and binary files, naming the file.
 std::string readFile(const std::string& path);
+inline constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{256} << 20;
 /// Absolute folder of a file path.
 std::string folderOf(const std::string& path);
 

@@ -2,25 +2,58 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace appell::io {
 
+std::string clipped(const std::string& value, std::size_t keep) {
+  if (value.size() <= keep) return value;
+  return value.substr(0, keep) + "… (" + std::to_string(value.size()) + " characters)";
+}
+
 std::string describe(const TiXmlElement* e) {
-  std::string s = "<" + std::string(e->Value());
-  if (const char* n = e->Attribute("name")) s += " name=\"" + std::string(n) + "\"";
-  else if (const char* l = e->Attribute("link")) s += " link=\"" + std::string(l) + "\"";
+  std::string s = "<" + clipped(e->Value());
+  if (const char* n = e->Attribute("name")) s += " name=\"" + clipped(n) + "\"";
+  else if (const char* l = e->Attribute("link")) s += " link=\"" + clipped(l) + "\"";
   return s + ">";
 }
+
+namespace {
+/// Every quoted value ('…' or "…") of a message, clipped: a message echoes
+/// the user's values, which may be megabytes long.
+std::string clipQuoted(const std::string& reason) {
+  if (reason.size() <= 256) return reason;
+  std::string out;
+  out.reserve(512);
+  for (std::size_t i = 0; i < reason.size();) {
+    const char c = reason[i];
+    if (c == '\'' || c == '"') {
+      const std::size_t end = reason.find(c, i + 1);
+      if (end != std::string::npos && end - i - 1 > 64) {
+        out += c;
+        out += clipped(reason.substr(i + 1, end - i - 1));
+        out += c;
+        i = end + 1;
+        continue;
+      }
+    }
+    out += c;
+    ++i;
+  }
+  return out;
+}
+}  // namespace
 
 void fail(const XmlSource& src, const TiXmlElement* e, const std::string& reason) {
   std::string where = src.file;
   if (e && e->Row() > 0) where += ":" + std::to_string(e->Row());
-  throw SceneError(where + ": " + (e ? describe(e) + ": " : std::string()) + reason);
+  throw SceneError(where + ": " + (e ? describe(e) + ": " : std::string()) + clipQuoted(reason));
 }
 
 void fail(const XmlSource& src, const std::string& reason) {
-  throw SceneError(src.file + ": " + reason);
+  throw SceneError(src.file + ": " + clipQuoted(reason));
 }
 
 std::optional<double> parseNumber(const std::string& str, bool* finite) {
@@ -32,6 +65,13 @@ std::optional<double> parseNumber(const std::string& str, bool* finite) {
   if (*first == '+') ++first;  // from_chars does not take a leading '+'
   double x = 0;
   const auto r = std::from_chars(first, last, x);
+  if (r.ec == std::errc::result_out_of_range && r.ptr == last) {
+    // A number, but beyond the doubles (1e309) or below their smallest (1e-400):
+    // the first is reported as not finite, the second reads as zero.
+    const bool huge = std::abs(std::strtod(std::string(first, last).c_str(), nullptr)) > 1;
+    if (finite) *finite = !huge;
+    return huge ? std::numeric_limits<double>::infinity() : 0.0;
+  }
   if (r.ec != std::errc() || r.ptr != last) return std::nullopt;
   if (finite) *finite = std::isfinite(x);
   return x;
@@ -60,14 +100,15 @@ std::vector<double> numbers(const XmlSource& src, const TiXmlElement* e, const c
     bool finite = true;
     const auto x = parseNumber(word, &finite);
     if (!x)
-      fail(src, e, std::string("attribute '") + attr + "': \"" + word + "\" is not a number");
+      fail(src, e, std::string("attribute '") + attr + "': \"" + clipped(word) + "\" is not a number");
     if (!finite)
-      fail(src, e, std::string("attribute '") + attr + "': \"" + word + "\" is not finite");
+      fail(src, e, std::string("attribute '") + attr + "': \"" + clipped(word) +
+                       "\" is not finite (out of the range of doubles, ±1.8e308)");
     out.push_back(*x);
   }
   if (count >= 0 && static_cast<int>(out.size()) != count)
     fail(src, e, std::string("attribute '") + attr + "' needs " + std::to_string(count) +
-                     " numbers, got " + std::to_string(out.size()) + " (\"" + s + "\")");
+                     " numbers, got " + std::to_string(out.size()) + " (\"" + clipped(s) + "\")");
   if (count < 0 && out.empty()) fail(src, e, std::string("attribute '") + attr + "' is empty");
   return out;
 }

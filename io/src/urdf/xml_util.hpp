@@ -28,6 +28,9 @@ std::string describe(const TiXmlElement* e);
 
 /// Parses one finite double; nullopt if `text` is not exactly one number
 /// (surrounding spaces allowed). `finite` is false for nan/inf.
+/// `value` as it goes into a message: at most `keep` characters, then how
+/// long it was (an attribute may hold megabytes).
+std::string clipped(const std::string& value, std::size_t keep = 64);
 std::optional<double> parseNumber(const std::string& text, bool* finite = nullptr);
 
 /// Attribute accessors. `what` names the attribute in messages.
