@@ -212,3 +212,35 @@ TEST(IoErrors, DeepNestingLongValuesAndHugeNumbersAreNamed) {
   // A file ending inside a UTF-8 sequence is malformed, nothing worse.
   EXPECT_NE(message(text + "\xC3").find("gen.urdf"), std::string::npos);
 }
+
+// Meshes are untrusted input: a face naming a vertex the mesh does not have
+// is an error naming the file and the face (it used to index out of bounds).
+// An axis whose norm overflows is still a direction.
+TEST(IoErrors, MeshFaceIndexBeyondTheVerticesAndHugeAxes) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("appell_mesh_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bad.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                    "property float y\nproperty float z\nelement face 1\n"
+                                    "property list uchar int vertex_indices\nend_header\n"
+                                    "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+  const std::string urdf = R"(<?xml version="1.0"?>
+<robot name="r"><link name="world"/>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <visual><geometry><mesh filename="bad.ply"/></geometry></visual></link>
+  <joint name="j" type="revolute"><parent link="world"/><child link="a"/><axis xyz="1e308 1e308 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>)";
+  try {
+    loadSceneFromString(urdf, dir.string(), "mesh.urdf");
+    ADD_FAILURE() << "a face beyond the vertices loaded";
+  } catch (const SceneError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("bad.ply: face 0 names vertex 7 but the mesh has 3 vertices"), std::string::npos) << m;
+  }
+  std::string ok = urdf;
+  ok.replace(ok.find("<visual>"), ok.find("</visual>") + 9 - ok.find("<visual>"), "");
+  const Scene s = loadSceneFromString(ok, dir.string(), "axis.urdf");
+  EXPECT_TRUE(s.model.joints[0].axis.isApprox(Vec3(1, 1, 0).normalized())) << s.model.joints[0].axis.transpose();
+  std::filesystem::remove_all(dir);
+}

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <functional>
 
@@ -37,12 +38,22 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale) {
   out.source = path;
   // Walk the node hierarchy so that each mesh instance gets its node's
   // transform (Collada and OBJ groups place parts with transforms).
-  std::function<void(const aiNode*, const aiMatrix4x4&)> visit = [&](const aiNode* node,
-                                                                     const aiMatrix4x4& parent) {
+  // The node tree, walked with an explicit stack (a Collada file may nest
+  // nodes 10⁴ deep: recursion would overflow the stack).
+  std::vector<std::pair<const aiNode*, aiMatrix4x4>> pending{{scene->mRootNode, aiMatrix4x4()}};
+  while (!pending.empty()) {
+    const auto [node, parent] = pending.back();
+    pending.pop_back();
     const aiMatrix4x4 T = parent * node->mTransformation;
     for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      if (node->mMeshes[k] >= scene->mNumMeshes)
+        throw SceneError(path + ": node '" + node->mName.C_Str() + "' names mesh " +
+                         std::to_string(node->mMeshes[k]) + " of " + std::to_string(scene->mNumMeshes));
       const aiMesh* mesh = scene->mMeshes[node->mMeshes[k]];
       if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+      if (out.vertices.size() + mesh->mNumVertices > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+        throw SceneError(path + ": more vertices than a mesh may have (" +
+                         std::to_string(out.vertices.size() + mesh->mNumVertices) + ")");
       const int base = static_cast<int>(out.vertices.size());
       for (unsigned i = 0; i < mesh->mNumVertices; ++i) {
         const aiVector3D p = T * mesh->mVertices[i];
@@ -51,14 +62,18 @@ TriangleMesh loadMesh(const std::string& path, const Vec3& scale) {
       for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
         const aiFace& face = mesh->mFaces[f];
         if (face.mNumIndices != 3) continue;
+        for (unsigned c = 0; c < 3; ++c)
+          if (face.mIndices[c] >= mesh->mNumVertices)
+            throw SceneError(path + ": face " + std::to_string(f) + " names vertex " +
+                             std::to_string(face.mIndices[c]) + " but the mesh has " +
+                             std::to_string(mesh->mNumVertices) + " vertices");
         out.triangles.push_back({base + static_cast<int>(face.mIndices[0]),
                                  base + static_cast<int>(face.mIndices[1]),
                                  base + static_cast<int>(face.mIndices[2])});
       }
     }
-    for (unsigned c = 0; c < node->mNumChildren; ++c) visit(node->mChildren[c], T);
-  };
-  visit(scene->mRootNode, aiMatrix4x4());
+    for (unsigned c = 0; c < node->mNumChildren; ++c) pending.emplace_back(node->mChildren[c], T);
+  }
   // Weld vertices at the same position: STL repeats corners per facet and
   // assimp keeps vertices apart when their normals differ; collision and
   // contact code want one vertex per corner.

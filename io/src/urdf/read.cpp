@@ -275,7 +275,9 @@ UrdfJoint readJoint(const XmlSource& src, const TiXmlElement* j) {
          "loader does not create)");
   joint.origin = origin(src, j);
   if (const TiXmlElement* a = j->FirstChildElement("axis")) {
-    const Vec3 axis = vec3(src, a, "xyz");
+    Vec3 axis = vec3(src, a, "xyz");
+    // Scaled first: "1e308 1e308 0" is a direction, but its norm overflows.
+    if (const double big = axis.cwiseAbs().maxCoeff(); big > 0) axis /= big;
     if (hasAxis(joint.type)) {
       if (axis.norm() < 1e-12) fail(src, a, "joint axis is zero");
       joint.axis = axis;
