@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 
 namespace appell::cli {
 
@@ -37,6 +38,10 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
                       joints (by default each finite one is a unilateral
                       constraint: the joint stops or bounces there)
   --quiet             no progress bar
+  --max-energy-error E  stop a passive scene whose relative energy error
+                      (impact losses counted) exceeds E, keeping the last state
+                      within it: the integration is diverging (default 0.05;
+                      inf switches the watch off)
 
 Exit status: 0 success, 1 bad input or an output that could not be written,
 130 interrupted (SIGINT: the summary and the trajectory up to the state reached
@@ -165,7 +170,8 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
 
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
-            {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path"},
+            {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
+             "max-energy-error"},
             {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kHelp);
@@ -188,6 +194,10 @@ int run(int argc, char** argv) {
     throw UsageError(e.what());
   }
   options.output_every = args.integer("every", 1);
+  if (args.has("max-energy-error"))
+    options.max_energy_error = args.text("max-energy-error") == "inf"
+                                   ? std::numeric_limits<double>::infinity()
+                                   : args.positiveNumber("max-energy-error", 5e-2);
   if (options.output_every < 1) throw UsageError("option --every must be at least 1");
   options.project_positions = options.project_velocities = !args.has("no-projection");
 

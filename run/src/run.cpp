@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace appell {
@@ -118,6 +119,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   double h = options.dt;
   long step = 0;
   bool last_sampled = true;
+  // The last state within the divergence bound, to go back to (sized once).
+  double t_good = sim.time();
+  VecX q_good = sim.q(), v_good = sim.v();
+  const bool watch = s.passive && std::isfinite(options.max_energy_error);
   while (sim.time() < options.duration * (1 - 1e-12)) {
     const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
     if (!status.ok) {
@@ -125,11 +130,28 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       s.failure = status.message;
       break;
     }
+    const double deviation = std::abs(sim.energy() + sim.impactEnergyLoss() - s.energy0);
+    if (watch && !(deviation <= options.max_energy_error * s.energy_scale)) {
+      // Diverging (an explicit method past its stability limit, a step too
+      // long for a stiff moment): stop before the numbers blow up.
+      std::ostringstream why;
+      why << "the energy error of this passive scene reached " << deviation / s.energy_scale
+          << " (relative) at t = " << sim.time() << " s, beyond the bound " << options.max_energy_error
+          << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
+      s.ok = false;
+      s.failure = why.str();
+      sim.setState(t_good, q_good, v_good);
+      break;
+    }
+    if (watch) {
+      t_good = sim.time();
+      q_good = sim.q();
+      v_good = sim.v();
+    }
     ++step;
     if (adaptive) h = status.h_next;
     record(sim);
-    s.max_energy_deviation = std::max(
-        s.max_energy_deviation, std::abs(sim.energy() + sim.impactEnergyLoss() - s.energy0));
+    s.max_energy_deviation = std::max(s.max_energy_deviation, deviation);
     s.max_velocity_residual = std::max(s.max_velocity_residual, sim.velocityResidual());
     s.max_gap_residual = std::max(s.max_gap_residual, sim.gapResidual());
     s.max_redundant = std::max(s.max_redundant, sim.redundantRows());

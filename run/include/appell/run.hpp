@@ -55,6 +55,11 @@ struct RunOptions {
   /// clean stop: the state reached is sampled, the summary says so). For a
   /// SIGINT handler or another thread; null: never.
   const std::atomic<bool>* stop = nullptr;
+  /// Divergence watch (passive scenes, whose E + impact losses is
+  /// conserved): a step after which |E + losses − E₀| exceeds this fraction
+  /// of the energy scale stops the run as failed, the state kept the last
+  /// one within the bound. ∞ switches it off.
+  double max_energy_error = 5e-2;
 };
 
 /// The scene's own settings as run options. Throws std::invalid_argument for
