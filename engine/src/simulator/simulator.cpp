@@ -200,7 +200,7 @@ StepStatus Simulator::step(double h) {
     if (!st.ok) return st;
   } else if (uni_) {
     uni_->zero_events = 0;
-    for (auto& r : uni_->rows) r.dir_start = r.dir;  // the next step's slip reference
+    for (auto& row : uni_->rows) row.dir_start = row.dir;  // the next step's slip reference
   }
   ++counters_.steps;
   return st;
