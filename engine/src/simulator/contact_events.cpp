@@ -108,7 +108,7 @@ int Simulator::crossedConstraint(detail::Crossing& type) const {
                frictionForce(k, result_.lambda).norm() > r.mu * fn + ftol)
         type = Crossing::Cone;
       else if (r.nf > 0 && cdata_->isSliding(r.c) &&
-               cdata_->slide[r.c].slip.head(r.nf).dot(r.dir_start.head(r.nf)) <
+               cdata_->slide[r.c].slip.dot(r.dir_start) <
                    -options_.contacts.speed_tol)
         type = Crossing::Slip;
     }
@@ -151,7 +151,7 @@ double Simulator::eventFunction(int k, detail::Crossing type) {
   const UnilateralRow& r = uni_->rows[k];
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   if (type == Crossing::Gap) return cdata_->gap[r.global];
-  if (type == Crossing::Slip) return cdata_->slide[r.c].slip.head(r.nf).dot(r.dir_start.head(r.nf));
+  if (type == Crossing::Slip) return cdata_->slide[r.c].slip.dot(r.dir_start);
   tau_.setZero();
   if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
   if (!solveDynamics(t_, q_, v_, tau_, uni_->res)) return std::numeric_limits<double>::quiet_NaN();

@@ -35,9 +35,10 @@ using detail::UnilateralRow;
 /// slip itself — keeps the step's starting direction.
 static void slipDirection(const ConstraintData& cd, UnilateralRow& r, double floor) {
   const auto& sr = cd.slide[r.c];
-  const auto slip = sr.slip.head(sr.n);
-  const double speed = slip.norm();
-  if (speed > floor && slip.dot(r.dir_start.head(sr.n)) > 0) r.dir.head(sr.n) = slip / speed;
+  // Components beyond the contact's friction rows are zero throughout (the
+  // rows' storage starts zero), so whole 3-vectors are used.
+  const double speed = sr.slip.norm();
+  if (speed > floor && sr.slip.dot(r.dir_start) > 0) r.dir = sr.slip / speed;
   else r.dir = r.dir_start;
 }
 
@@ -66,11 +67,11 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
     g.setZero();
     if (r.a >= 0) {
       spatialJacobianWorld(model_, *data_, r.a, u->J);
-      g.noalias() += u->J.transpose() * (sr.Wa.topRows(sr.n).transpose() * f.head(sr.n));
+      g.noalias() += u->J.transpose() * (sr.Wa.transpose() * f);
     }
     if (r.b >= 0) {
       spatialJacobianWorld(model_, *data_, r.b, u->J);
-      g.noalias() -= u->J.transpose() * (sr.Wb.topRows(sr.n).transpose() * f.head(sr.n));
+      g.noalias() -= u->J.transpose() * (sr.Wb.transpose() * f);
     }
   }
   solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, SolveOutputs::All);
