@@ -7,6 +7,7 @@
 #include <appell/urdf.hpp>
 
 #include "ball.hpp"
+#include "simulation_helpers.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,13 +20,6 @@ namespace {
 
 constexpr double kG = 9.81;
 
-IntegratorOptions tight() {
-  IntegratorOptions o;
-  o.rtol = 1e-12;
-  o.atol = 1e-12;
-  o.h_max = 0.01;
-  return o;
-}
 
 /// A ball of radius r whose centre starts h above its resting height, with
 /// the given world angular velocity and horizontal centre velocity.
@@ -42,16 +36,6 @@ BuiltScene raisedBall(double h, const Vec3& omega, const Vec3& vG, double restit
   return s;
 }
 
-std::vector<ContactEvent> runCollecting(Simulator& sim, double t_end, double h) {
-  std::vector<ContactEvent> all;
-  while (sim.time() < t_end - 1e-12) {
-    const StepStatus st = sim.step(std::min(h, t_end - sim.time()));
-    EXPECT_TRUE(st.ok) << st.message;
-    if (!st.ok) break;
-    all.insert(all.end(), sim.events().begin(), sim.events().end());
-  }
-  return all;
-}
 
 double centreHeight(const Simulator& sim) { return sim.q()[2]; }
 
@@ -66,10 +50,10 @@ TEST(ContactEvents, DroppedBallTouchesDownAtTheFreeFallTime) {
   for (IntegratorType it : {IntegratorType::DormandPrince54, IntegratorType::RK4}) {
     for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
       BuiltScene s = raisedBall(h, Vec3::Zero(), Vec3::Zero(), 0.0);
-      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, tight());
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, appell::test::tightIntegrator());
       ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
       EXPECT_FALSE(sim.isClosed(0)) << "a ball above the plane starts with its contact open";
-      const auto events = runCollecting(sim, 0.4, 1e-2);
+      const auto events = appell::test::advanceCollecting(sim, 0.4, 1e-2);
       ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it);
       EXPECT_EQ(events[0].kind, ContactEventKind::Touchdown);
       EXPECT_NEAR(events[0].t, t_star, 1e-10) << toString(f) << " " << toString(it);
@@ -93,9 +77,9 @@ TEST(ContactEvents, PlasticRollingImpactConservesAngularMomentumAboutTheContactP
   for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
     BuiltScene s = raisedBall(0.05, omega, vG, 0.0);
     Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
-                  IntegratorType::DormandPrince54, tight());
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
     ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
-    const auto events = runCollecting(sim, 0.2, 1e-2);
+    const auto events = appell::test::advanceCollecting(sim, 0.2, 1e-2);
     ASSERT_GE(events.size(), 1u);
     ASSERT_EQ(events[0].kind, ContactEventKind::Touchdown);
     // Flight: ω and the horizontal velocity are constant; the impact's
@@ -123,7 +107,7 @@ TEST(ContactEvents, BouncingBallApexesDecayAsRestitutionSquaredAndTheSequenceEnd
     SimulatorOptions so;
     so.contacts.rest_speed = 0.05;
     Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
-                  IntegratorType::DormandPrince54, tight(), so);
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator(), so);
     ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
     const double E_rest = 0.5 * kG * 0.1;  // m g r: resting on the plane
     const double E0 = sim.energy() - E_rest;
@@ -172,13 +156,13 @@ TEST(ContactEvents, BallPulledUpLiftsOffWhenTheNormalForceVanishes) {
   for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
     for (IntegratorType it : {IntegratorType::DormandPrince54, IntegratorType::RK4}) {
       BuiltScene s = raisedBall(0.0, Vec3(0, 3.0, 0), Vec3(0.3, 0, 0), 0.0);
-      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, tight());
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, appell::test::tightIntegrator());
       sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
         tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(0, 0, k * t);
       });
       ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
       EXPECT_TRUE(sim.isClosed(0));
-      const auto events = runCollecting(sim, t_star + 0.5, 1e-2);
+      const auto events = appell::test::advanceCollecting(sim, t_star + 0.5, 1e-2);
       ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it);
       EXPECT_EQ(events[0].kind, ContactEventKind::LiftOff);
       EXPECT_NEAR(events[0].t, t_star, 1e-10) << toString(f) << " " << toString(it);
@@ -214,10 +198,11 @@ TEST(ContactEvents, TreeAndKktAgreeAtEveryActiveSetOfTheCar) {
     EXPECT_LT((rt.vdot - rk.vdot).lpNorm<Eigen::Infinity>(), 1e-9 * (1 + rk.vdot.norm())) << "set " << set;
     EXPECT_LT((rt.lambda - rk.lambda).lpNorm<Eigen::Infinity>(), 1e-8 * (1 + rk.lambda.norm())) << "set " << set;
     EXPECT_EQ(rt.redundant, rk.redundant) << "set " << set;
-    for (int c = 0; c < 4; ++c)
-      if (!cd.isActive(c))
-        for (int r = 0; r < scene.constraints[c]->rows(); ++r)
-          EXPECT_EQ(rt.lambda[cd.offset[c] + r], 0.0) << "open tyre " << c;
+    for (int c = 0; c < 4; ++c) {
+      if (cd.isActive(c)) continue;
+      for (int r = 0; r < scene.constraints[c]->rows(); ++r)
+        EXPECT_EQ(rt.lambda[cd.offset[c] + r], 0.0) << "open tyre " << c;
+    }
   }
   EXPECT_EQ(cd.m_active, cd.m);
 }
@@ -237,7 +222,7 @@ TEST(ContactEvents, RimlessWheelLandsAndLiftsFeetPairwiseWithTheImpactLaw) {
   const double ratio = (I + m * d12) / (I + m * d22);
   for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
     Simulator sim(scene.model, scene.constraints, makeSolver(f, scene.model, scene.constraints),
-                  IntegratorType::DormandPrince54, tight());
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
     ASSERT_TRUE(sim.setState(0, scene.q0, scene.v0)) << sim.lastStateError();
     int closed = 0;
     for (int c = 0; c < 16; ++c) closed += sim.isClosed(c) ? 1 : 0;
@@ -330,7 +315,11 @@ BallOnPaddle ballOnPaddle(double m1, double m2, double h, double e) {
   s.model = b.build();
   Support top{Plane{}, StaticMotion{}, "paddle_top"};
   top.body = paddle;
-  ContactSpec spec{ContactKind::Rolling, ball, Sphere{r, Vec3::Zero()}, top};
+  ContactSpec spec;
+  spec.kind = ContactKind::Rolling;
+  spec.body = ball;
+  spec.shape = Sphere{r, Vec3::Zero()};
+  spec.support = top;
   spec.restitution = e;
   spec.options.name = "ball_paddle";
   s.constraints.push_back(makeContact(spec));
@@ -356,7 +345,7 @@ TEST(ContactEvents, BallOnAFloatingPaddleExchangesMomentumAtImpact) {
     for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
       BallOnPaddle s = ballOnPaddle(m1, m2, h, e);
       Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
-                    IntegratorType::DormandPrince54, tight());
+                    IntegratorType::DormandPrince54, appell::test::tightIntegrator());
       const VecX tau = s.tau;
       sim.setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
       ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
@@ -407,12 +396,12 @@ TEST(ContactEvents, BilateralContactsHoldWhenPulled) {
       so.contacts.enabled = false;
     }
     Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
-                  IntegratorType::DormandPrince54, tight(), so);
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator(), so);
     sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
       tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(0, 0, k * t);
     });
     ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
-    const auto events = runCollecting(sim, t_star + 0.5, 1e-2);
+    const auto events = appell::test::advanceCollecting(sim, t_star + 0.5, 1e-2);
     EXPECT_TRUE(events.empty());
     EXPECT_TRUE(sim.isClosed(0));
     EXPECT_NEAR(sim.lambda()[2], m * kG - k * sim.time(), 1e-9) << "the contact pulls";
@@ -453,10 +442,10 @@ TEST(ContactEvents, CarDroppedLevelLandsOnFourWheelsAtOnce) {
     scene.q0[2] += 0.1;
     scene.tau.setZero();
     Simulator sim(scene.model, scene.constraints, makeSolver(f, scene.model, scene.constraints),
-                  IntegratorType::DormandPrince54, tight());
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
     ASSERT_TRUE(sim.setState(0, scene.q0, scene.v0));
     for (int c = 0; c < 4; ++c) EXPECT_FALSE(sim.isClosed(c));
-    const auto events = runCollecting(sim, 0.3, 1e-2);
+    const auto events = appell::test::advanceCollecting(sim, 0.3, 1e-2);
     ASSERT_EQ(events.size(), 4u) << toString(f);
     for (const ContactEvent& e : events) {
       EXPECT_EQ(e.kind, ContactEventKind::Touchdown);

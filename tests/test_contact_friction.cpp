@@ -6,6 +6,7 @@
 #include <appell/simulator.hpp>
 
 #include "ball.hpp"
+#include "simulation_helpers.hpp"
 
 #include <cmath>
 
@@ -16,13 +17,6 @@ namespace {
 
 constexpr double kG = 9.81, kM = 0.5, kR = 0.1;
 
-IntegratorOptions tight() {
-  IntegratorOptions o;
-  o.rtol = 1e-12;
-  o.atol = 1e-12;
-  o.h_max = 0.01;
-  return o;
-}
 
 /// A ball on the plane z = 0 with friction μ, centre velocity vG and world
 /// angular velocity ω (not necessarily rolling), under gravity `g`.
@@ -42,16 +36,6 @@ BuiltScene ballWithFriction(double mu, const Vec3& vG, const Vec3& omega, const 
 Vec3 centreVelocity(const Simulator& sim) { return floatingRotation(sim.q(), 0) * Vec3(sim.v().tail<3>()); }
 Vec3 angularVelocity(const Simulator& sim) { return floatingRotation(sim.q(), 0) * Vec3(sim.v().head<3>()); }
 
-std::vector<ContactEvent> advance(Simulator& sim, double t_end, double h = 1e-2) {
-  std::vector<ContactEvent> all(sim.events().begin(), sim.events().end());
-  while (sim.time() < t_end - 1e-12) {
-    const StepStatus st = sim.step(std::min(h, t_end - sim.time()));
-    EXPECT_TRUE(st.ok) << st.message;
-    if (!st.ok) break;
-    all.insert(all.end(), sim.events().begin(), sim.events().end());
-  }
-  return all;
-}
 
 }  // namespace
 
@@ -63,17 +47,17 @@ TEST(ContactFriction, SlidingBallStartsRollingAtFiveSevenths) {
   for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
     BuiltScene s = ballWithFriction(mu, Vec3(v0, 0, 0), Vec3::Zero(), Vec3(0, 0, -kG));
     Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
-                  IntegratorType::DormandPrince54, tight());
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
     ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
     ASSERT_TRUE(sim.constraintData().isSliding(0)) << "an initial state that slips starts sliding";
-    const auto events = advance(sim, 0.5 * t_star);
+    const auto events = appell::test::advanceCollecting(sim, 0.5 * t_star);
     EXPECT_NEAR(centreVelocity(sim).x(), v0 - mu * kG * sim.time(), 1e-9) << toString(f);
     EXPECT_NEAR(angularVelocity(sim).y(), 5 * mu * kG / (2 * kR) * sim.time(), 1e-8) << toString(f);
     EXPECT_NEAR(sim.lambda().head<2>().norm(), mu * kM * kG, 1e-9) << "the friction force on the tangent rows";
     EXPECT_NEAR((sim.lambda()[0] * sim.contactFrame(0).t1 + sim.lambda()[1] * sim.contactFrame(0).t2).x(),
                 -mu * kM * kG, 1e-9) << "against the slip";
     EXPECT_NEAR(sim.lambda()[2], kM * kG, 1e-9);
-    const auto later = advance(sim, 2 * t_star);
+    const auto later = appell::test::advanceCollecting(sim, 2 * t_star);
     ASSERT_EQ(later.size(), 1u) << toString(f);
     EXPECT_EQ(later[0].kind, ContactEventKind::Stick);
     EXPECT_NEAR(later[0].t, t_star, 1e-10) << toString(f);
@@ -94,12 +78,12 @@ TEST(ContactFriction, PushedBallSlipsWhenTheDemandReachesMu) {
   for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
     for (IntegratorType it : {IntegratorType::DormandPrince54}) {
       BuiltScene s = ballWithFriction(mu, Vec3::Zero(), Vec3::Zero(), Vec3(0, 0, -kG));
-      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, tight());
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, appell::test::tightIntegrator());
       sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
         tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
       });
       ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
-      const auto events = advance(sim, t_star + 0.2);
+      const auto events = appell::test::advanceCollecting(sim, t_star + 0.2);
       ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it);
       EXPECT_EQ(events[0].kind, ContactEventKind::Slip);
       EXPECT_NEAR(events[0].t, t_star, 1e-10) << toString(f) << " " << toString(it);
@@ -122,11 +106,11 @@ TEST(ContactFriction, BallOnAnInclineRollsBelowTheFrictionAngleAndSlidesAbove) {
     for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
       BuiltScene s = ballWithFriction(mu, Vec3::Zero(), Vec3::Zero(), g);
       Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
-                    IntegratorType::DormandPrince54, tight());
+                    IntegratorType::DormandPrince54, appell::test::tightIntegrator());
       ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
       const bool slides = std::tan(alpha) > 3.5 * mu;
       EXPECT_EQ(sim.constraintData().isSliding(0), slides) << "alpha " << alpha;
-      advance(sim, 0.5);
+      appell::test::advanceCollecting(sim, 0.5);
       const double a = slides ? kG * (std::sin(alpha) - mu * std::cos(alpha)) : 5.0 / 7 * kG * std::sin(alpha);
       EXPECT_NEAR(centreVelocity(sim).x(), a * sim.time(), 1e-9) << "alpha " << alpha << " " << toString(f);
       const double wdot = slides ? 5 * mu * kG * std::cos(alpha) / (2 * kR) : a / kR;

@@ -7,6 +7,7 @@
 #include <appell/joint_limit.hpp>
 #include <appell/simulator.hpp>
 #include <appell/urdf.hpp>
+#include "simulation_helpers.hpp"
 
 #include <cmath>
 
@@ -16,13 +17,6 @@ namespace {
 
 constexpr double kG = 9.81;
 
-IntegratorOptions tight() {
-  IntegratorOptions o;
-  o.rtol = 1e-12;
-  o.atol = 1e-12;
-  o.h_max = 0.01;
-  return o;
-}
 
 /// A body of mass m on a vertical prismatic joint, limit q ≥ 0.
 Model slider(double m) {
@@ -45,16 +39,6 @@ Model pendulum(double m, double l, double theta_limit) {
   return model;
 }
 
-std::vector<ContactEvent> advance(Simulator& sim, double t_end) {
-  std::vector<ContactEvent> all;
-  while (sim.time() < t_end - 1e-12) {
-    const StepStatus st = sim.step(std::min(1e-2, t_end - sim.time()));
-    EXPECT_TRUE(st.ok) << st.message;
-    if (!st.ok) break;
-    all.insert(all.end(), sim.events().begin(), sim.events().end());
-  }
-  return all;
-}
 
 }  // namespace
 
@@ -67,13 +51,13 @@ TEST(JointLimits, SliderFallsOntoItsLimitAndStopsOrBounces) {
   for (double e : {0.0, 1.0}) {
     for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
       const ConstraintList c{std::make_shared<JointLimit>(model, 0, LimitSide::Lower, e)};
-      Simulator sim(model, c, makeSolver(f, model, c), IntegratorType::DormandPrince54, tight());
+      Simulator sim(model, c, makeSolver(f, model, c), IntegratorType::DormandPrince54, appell::test::tightIntegrator());
       VecX q(1), v(1);
       q << h;
       v << 0;
       ASSERT_TRUE(sim.setState(0, q, v));
       EXPECT_FALSE(sim.isClosed(0));
-      const auto events = advance(sim, t_star + 0.05);
+      const auto events = appell::test::advanceCollecting(sim, t_star + 0.05);
       ASSERT_EQ(events.size(), 1u) << "e = " << e;
       EXPECT_NEAR(events[0].t, t_star, 1e-10);
       EXPECT_NEAR(events[0].speed_before, -kG * t_star, 1e-9);
@@ -105,7 +89,7 @@ TEST(JointLimits, PendulumBouncesStopsRestsAndLeavesItsLimit) {
     for (double e : {1.0, 0.0}) {
       const ConstraintList c{std::make_shared<JointLimit>(model, 0, LimitSide::Lower, e),
                              std::make_shared<JointLimit>(model, 0, LimitSide::Upper, e)};
-      Simulator sim(model, c, makeSolver(f, model, c), IntegratorType::DormandPrince54, tight());
+      Simulator sim(model, c, makeSolver(f, model, c), IntegratorType::DormandPrince54, appell::test::tightIntegrator());
       const double w0 = e == 1 ? 2.0 : 0.0, tau0 = e == 1 ? 0.0 : 3.0;
       sim.setJointForces([&](double, const VecX&, const VecX&, VecX& tau) { tau[0] = tau0; });
       VecX q(1), v(1);
@@ -136,7 +120,7 @@ TEST(JointLimits, PendulumBouncesStopsRestsAndLeavesItsLimit) {
         EXPECT_NEAR(sim.lambda()[1], tau0 - m * kG * l * std::sin(limit), 1e-9);
         const double k = 2.0, t0 = sim.time(), t_star = t0 + (tau0 - m * kG * l * std::sin(limit)) / k;
         sim.setJointForces([&, t0](double t, const VecX&, const VecX&, VecX& tau) { tau[0] = tau0 - k * (t - t0); });
-        const auto later = advance(sim, t_star + 0.1);
+        const auto later = appell::test::advanceCollecting(sim, t_star + 0.1);
         ASSERT_EQ(later.size(), 1u);
         EXPECT_EQ(later[0].kind, ContactEventKind::LiftOff);
         EXPECT_NEAR(later[0].t, t_star, 1e-9);

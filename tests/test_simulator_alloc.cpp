@@ -190,8 +190,11 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
   const int ball = b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
                              Inertia{m, Vec3::Zero(), Vec3::Constant(I).asDiagonal()});
   const Model model = b.build();
-  ContactSpec spec{ContactKind::Rolling, ball, Sphere{r, Vec3::Zero()},
-                   Support{Plane{}, StaticMotion{}, "ground", -1}};
+  ContactSpec spec;
+  spec.kind = ContactKind::Rolling;
+  spec.body = ball;
+  spec.shape = Sphere{r, Vec3::Zero()};
+  spec.support = Support{Plane{}, StaticMotion{}, "ground", -1};
   spec.restitution = 0.5;
   const ConstraintList c{makeContact(spec)};
   VecX q = neutralConfiguration(model);
