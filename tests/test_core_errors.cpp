@@ -206,3 +206,31 @@ TEST(CoreErrors, UnknownIntegratorName) {
   }
   EXPECT_EQ(integratorFromString("rk4"), IntegratorType::RK4);
 }
+
+// Duplicate joint names are found in one pass (a hash set, not every pair)
+// and named; a long chain builds with every name distinct.
+TEST(CoreErrors, DuplicateJointNamesAndLongChains) {
+  const Inertia link{1.0, Vec3(0, 0, -0.5), Vec3(0.1, 0.1, 0.01).asDiagonal()};
+  {
+    ModelBuilder b;
+    b.addBody("a", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitY(), link, "j");
+    b.addBody("b", 0, SE3::Identity(), JointType::Revolute, Vec3::UnitY(), link, "j");
+    try {
+      b.build();
+      ADD_FAILURE() << "two joints named j accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("joint name 'j' is used twice"), std::string::npos) << e.what();
+    }
+  }
+  ModelBuilder b;
+  SE3 X;
+  X.p = Vec3(0, 0, -1);
+  int parent = -1;
+  for (int i = 0; i < 20000; ++i)
+    parent = b.addBody("l" + std::to_string(i), parent, parent < 0 ? SE3::Identity() : X, JointType::Revolute,
+                       Vec3::UnitY(), link, "j" + std::to_string(i));
+  const Model m = b.build();
+  EXPECT_EQ(m.nbodies, 20000);
+  EXPECT_EQ(m.nv, 20000);
+  EXPECT_EQ(m.jointIndex("j19999"), 19999);
+}

@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <sstream>
+#include <string_view>
+#include <unordered_set>
 
 namespace appell {
 
@@ -221,10 +223,13 @@ Model ModelBuilder::build() const {
     if (e.parent >= 0) m.children[e.parent].push_back(i);
     for (int k = 0; k < j.nv; ++k) m.body_of_v.push_back(i);
   }
-  for (int i = 0; i < n; ++i) {
-    for (int k = 0; k < i; ++k)
-      if (m.joint_names[k] == m.joint_names[i]) fail(m.body_names[i], "joint name '" + m.joint_names[i] + "' is used twice");
-  }
+  // One pass with a hash set: O(n), not a comparison of every pair (a 10⁵-link
+  // chain would take minutes).
+  std::unordered_set<std::string_view> joint_names;
+  joint_names.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i)
+    if (!joint_names.insert(m.joint_names[i]).second)
+      fail(m.body_names[i], "joint name '" + m.joint_names[i] + "' is used twice");
   checkMasslessJoints(m);
   return m;
 }
