@@ -207,8 +207,9 @@ TEST(CoreErrors, UnknownIntegratorName) {
   EXPECT_EQ(integratorFromString("rk4"), IntegratorType::RK4);
 }
 
-// Duplicate joint names are found in one pass (a hash set, not every pair)
-// and named; a long chain builds with every name distinct.
+// Duplicate joint and body names are found in one pass (hash sets, not every
+// pair) and named; a 10⁵-link chain builds (0.2 s; the pairwise checks took
+// minutes).
 TEST(CoreErrors, DuplicateJointNamesAndLongChains) {
   const Inertia link{1.0, Vec3(0, 0, -0.5), Vec3(0.1, 0.1, 0.01).asDiagonal()};
   {
@@ -226,11 +227,11 @@ TEST(CoreErrors, DuplicateJointNamesAndLongChains) {
   SE3 X;
   X.p = Vec3(0, 0, -1);
   int parent = -1;
-  for (int i = 0; i < 20000; ++i)
+  for (int i = 0; i < 100000; ++i)
     parent = b.addBody("l" + std::to_string(i), parent, parent < 0 ? SE3::Identity() : X, JointType::Revolute,
                        Vec3::UnitY(), link, "j" + std::to_string(i));
   const Model m = b.build();
-  EXPECT_EQ(m.nbodies, 20000);
-  EXPECT_EQ(m.nv, 20000);
-  EXPECT_EQ(m.jointIndex("j19999"), 19999);
+  EXPECT_EQ(m.nbodies, 100000);
+  EXPECT_EQ(m.nv, 100000);
+  EXPECT_EQ(m.jointIndex("j99999"), 99999);
 }

@@ -169,12 +169,13 @@ Model ModelBuilder::build() const {
     subtree_mass[i] += entries_[i].inertia.mass;
     if (entries_[i].parent >= 0 && entries_[i].parent < i) subtree_mass[entries_[i].parent] += subtree_mass[i];
   }
+  std::unordered_set<std::string_view> body_names;  // one pass, not every pair
+  body_names.reserve(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     const Entry& e = entries_[i];
     if (e.parent >= i || e.parent < -1)
       fail(e.name, "parent index " + std::to_string(e.parent) + " is not an earlier body");
-    for (int k = 0; k < i; ++k)
-      if (entries_[k].name == e.name) fail(e.name, "two bodies share this name");
+    if (!body_names.insert(e.name).second) fail(e.name, "two bodies share this name");
     if (!finite(e.placement.R) || !finite(e.placement.p)) fail(e.name, "joint placement is not finite");
     if ((e.placement.R.transpose() * e.placement.R - Mat3::Identity()).norm() > 1e-9)
       fail(e.name, "joint placement rotation is not orthonormal");
