@@ -166,8 +166,9 @@ TEST(IoErrors, DevicesDirectoriesAndUtf16AreNamed) {
     }
     return std::string("(loaded)");
   };
-  if (std::filesystem::exists("/dev/zero"))
+  if (std::filesystem::exists("/dev/zero")) {
     EXPECT_NE(message("/dev/zero").find("/dev/zero: not a regular file"), std::string::npos);
+  }
   const std::filesystem::path dir = std::filesystem::temp_directory_path();
   EXPECT_NE(message(dir.string()).find("is a directory"), std::string::npos);
   const std::string u16 = (dir / ("appell_u16_" + std::to_string(::getpid()) + ".urdf")).string();

@@ -83,7 +83,7 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
     fail(e.what());
   }
   if (auto* p = std::get_if<Plane>(&support.surface)) p->normal.normalize();
-  // Face normals, adjacency and the box tree, once (evaluation must not allocate).
+  // Face normals, adjacency and FCL's hierarchy, once (evaluation must not allocate).
   if (auto* t = std::get_if<TerrainMesh>(&support.surface); t && !t->index)
     *t = makeTerrain(t->vertices, t->triangles);
   std::string why;

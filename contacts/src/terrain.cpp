@@ -1,10 +1,11 @@
-// Terrain meshes: validation, face normals, edge adjacency and the box tree.
+// Terrain meshes: validation, face normals, edge adjacency and FCL's hierarchy.
 #include "terrain_index.hpp"
+
+#include <fcl/geometry/bvh/detail/BV_splitter.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -23,41 +24,28 @@ Vec3 rawNormal(const TerrainMesh& t, int f) {
   return (t.vertices[tri[1]] - a).cross(t.vertices[tri[2]] - a);
 }
 
-// Median split along the longest axis of the centroids' box; leaves of ≤ 4 faces.
-int build(const TerrainMesh& t, TerrainIndex& idx, std::vector<Vec3>& centroid, int first,
-          int count, int depth) {
-  idx.depth = std::max(idx.depth, depth);
-  const int id = static_cast<int>(idx.nodes.size());
-  idx.nodes.emplace_back();
-  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-  Vec3 clo = lo, chi = hi;
-  for (int k = first; k < first + count; ++k) {
-    const int f = idx.order[k];
-    for (int v : t.triangles[f]) {
-      lo = lo.cwiseMin(t.vertices[v]);
-      hi = hi.cwiseMax(t.vertices[v]);
-    }
-    clo = clo.cwiseMin(centroid[f]);
-    chi = chi.cwiseMax(centroid[f]);
-  }
-  idx.nodes[id].lo = lo;
-  idx.nodes[id].hi = hi;
-  if (count <= 4) {
-    idx.nodes[id].first = first;
-    idx.nodes[id].count = count;
-    return id;
-  }
-  int axis = 0;
-  (chi - clo).maxCoeff(&axis);
-  const int half = count / 2;
-  std::nth_element(idx.order.begin() + first, idx.order.begin() + first + half,
-                   idx.order.begin() + first + count,
-                   [&](int a, int b) { return centroid[a](axis) < centroid[b](axis); });
-  const int left = build(t, idx, centroid, first, half, depth + 1);
-  const int right = build(t, idx, centroid, first + half, count - half, depth + 1);
-  idx.nodes[id].left = left;
-  idx.nodes[id].right = right;
-  return id;
+// FCL's hierarchy over the triangles, split at the median along the axis of
+// greatest spread (depth ⌈log₂ n⌉ + 1; FCL's default mean split can be deep
+// on clustered meshes).
+std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> buildHierarchy(const TerrainMesh& t) {
+  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
+  bvh->bv_splitter = std::make_shared<fcl::detail::BVSplitter<fcl::OBBRSSd>>(
+      fcl::detail::SPLIT_METHOD_MEDIAN);
+  std::vector<fcl::Triangle> tris;
+  tris.reserve(t.triangles.size());
+  for (const auto& tri : t.triangles) tris.emplace_back(tri[0], tri[1], tri[2]);
+  if (bvh->beginModel(static_cast<int>(tris.size()), static_cast<int>(t.vertices.size())) !=
+          fcl::BVH_OK ||
+      bvh->addSubModel(t.vertices, tris) != fcl::BVH_OK || bvh->endModel() != fcl::BVH_OK)
+    fail("FCL could not build its bounding-volume hierarchy");
+  return bvh;
+}
+
+// Longest root-to-leaf path, in nodes.
+int hierarchyDepth(const fcl::BVHModel<fcl::OBBRSSd>& bvh, int node) {
+  const auto& n = bvh.getBV(node);
+  if (n.isLeaf()) return 1;
+  return 1 + std::max(hierarchyDepth(bvh, n.leftChild()), hierarchyDepth(bvh, n.rightChild()));
 }
 
 }  // namespace
@@ -97,7 +85,6 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
   auto idx = std::make_shared<TerrainIndex>();
   idx->normal.resize(nf);
   idx->neighbour.assign(nf, {-1, -1, -1});
-  std::vector<Vec3> centroid(nf);
   // Vertices welded by position: STL files repeat each vertex per triangle,
   // and edge neighbours must still be found.
   std::vector<int> weld(t.vertices.size());
@@ -113,7 +100,6 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
   for (int f = 0; f < nf; ++f) {
     const auto& tri = t.triangles[f];
     idx->normal[f] = terrainFaceNormal(t, f);
-    centroid[f] = (t.vertices[tri[0]] + t.vertices[tri[1]] + t.vertices[tri[2]]) / 3.0;
     for (int k = 0; k < 3; ++k) {
       const int a = weld[tri[(k + 1) % 3]], b = weld[tri[(k + 2) % 3]];
       const auto key = std::minmax(a, b);
@@ -127,11 +113,9 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
       }
     }
   }
-  idx->order.resize(nf);
-  std::iota(idx->order.begin(), idx->order.end(), 0);
-  idx->nodes.reserve(2 * nf);
-  build(t, *idx, centroid, 0, nf, 1);
-  if (idx->depth >= detail::kTerrainStack) fail("box tree too deep");
+  idx->bvh = buildHierarchy(t);
+  idx->depth = hierarchyDepth(*idx->bvh, 0);
+  if (idx->depth >= detail::kTerrainStack) fail("bounding-volume hierarchy too deep");
   t.index = std::move(idx);
   return t;
 }

@@ -1,47 +1,63 @@
-// Private layout of a terrain's index: face planes, edge neighbours and a
-// bounding-box tree over the triangles (built once, queried without allocation).
+// Private layout of a terrain's index: face planes, edge neighbours and FCL's
+// bounding-volume hierarchy over the triangles (built once, queried without
+// allocation).
+//
+// The hierarchy is FCL's BVHModel with OBBRSS volumes (Larsen, Gottschalk,
+// Lin & Manocha, "Fast proximity queries with swept sphere volumes", 1999;
+// Gottschalk, Lin & Manocha, "OBBTree", SIGGRAPH 1996), split at the median so
+// that its depth is ⌈log₂ faces⌉ + 1. The same model serves FCL's own
+// distance and collision queries (collision.hpp). For the per-evaluation
+// candidate search the contact code walks FCL's nodes itself with a
+// fixed-size stack: FCL's query entry points fill std::vectors of results,
+// and a contact evaluation must not allocate.
 #pragma once
 
 #include <appell/contact_geometry.hpp>
 #include <appell/terrain.hpp>
 
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/math/bv/OBBRSS.h>
+
 namespace appell {
 
 struct TerrainIndex {
-  struct Node {
-    Vec3 lo, hi;           ///< box of the triangles below this node
-    int left = -1, right = -1;
-    int first = 0, count = 0;  ///< leaf: order[first, first + count)
-  };
   std::vector<Vec3> normal;                      ///< unit face normals (support frame)
   /// neighbour[f][k]: the face across the edge opposite vertex k of f, or −1.
   std::vector<std::array<int, 3>> neighbour;
-  std::vector<Node> nodes;                       ///< nodes[0] is the root
-  std::vector<int> order;                        ///< face indices, grouped by leaf
+  /// FCL's hierarchy over the triangles (one triangle per leaf, leaf
+  /// primitiveId() = index into TerrainMesh::triangles).
+  std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> bvh;
   int depth = 0;                                 ///< longest root-to-leaf path (nodes)
 };
 
 namespace detail {
 
-/// Depth the query stack must hold; makeTerrain refuses deeper trees (it never
-/// builds one: the median split halves the faces at each level).
+/// Depth the query stack must hold; makeTerrain refuses deeper trees (the
+/// median split never builds one below 2⁶³ faces).
 constexpr int kTerrainStack = 64;
 
-/// Calls visit(face) for every face whose box overlaps [lo, hi]. No allocation.
+/// Calls visit(face) for every face whose bounding volume's axis-aligned box
+/// overlaps [lo, hi]. No allocation.
 template <class F>
 void forEachFaceInBox(const TerrainIndex& index, const Vec3& lo, const Vec3& hi, F&& visit) {
-  if (index.nodes.empty()) return;
+  const auto& bvh = *index.bvh;
+  if (bvh.getNumBVs() == 0) return;
   int stack[kTerrainStack];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
-    const TerrainIndex::Node& n = index.nodes[stack[--top]];
-    if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
-    if (n.count > 0) {
-      for (int k = 0; k < n.count; ++k) visit(index.order[n.first + k]);
+    const auto& node = bvh.getBV(stack[--top]);
+    // The box of the node's oriented box: centre To, half-widths |axis|·extent.
+    const auto& obb = node.bv.obb;
+    const Vec3 half = obb.axis.cwiseAbs() * obb.extent;
+    if (((obb.To - half).array() > hi.array()).any() ||
+        ((obb.To + half).array() < lo.array()).any())
+      continue;
+    if (node.isLeaf()) {
+      visit(node.primitiveId());
     } else {
-      stack[top++] = n.left;
-      stack[top++] = n.right;
+      stack[top++] = node.leftChild();
+      stack[top++] = node.rightChild();
     }
   }
 }

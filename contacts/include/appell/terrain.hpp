@@ -18,9 +18,10 @@
 // clockwise seen from above). Degenerate triangles (area ≈ 0), bad indices and
 // non-finite vertices are rejected by makeTerrain / validateTerrain.
 //
-// Broad phase: an axis-aligned bounding-box tree over the triangles, built
-// once by makeTerrain; the query for a body uses the box of its extreme
-// points and a fixed-size stack, so contact evaluation does not allocate.
+// Broad phase: FCL's bounding-volume hierarchy (OBBRSS) over the triangles,
+// built once by makeTerrain; the query for a body walks it with the box of the
+// body's extreme points and a fixed-size stack, so contact evaluation does not
+// allocate. The same hierarchy answers FCL's distance queries (collision.hpp).
 #pragma once
 
 #include <appell/spatial.hpp>
@@ -31,7 +32,7 @@
 
 namespace appell {
 
-/// Face planes, edge adjacency and the bounding-box tree (private layout).
+/// Face planes, edge adjacency and FCL's hierarchy (private layout).
 struct TerrainIndex;
 
 struct TerrainMesh {
