@@ -162,7 +162,7 @@ TEST(ContactFactory, BadDeclarationsAreClearErrors) {
   expectContactError(ContactKind::Rolling, 0, Box{}, ground, none, "a box cannot roll");
   expectContactError(ContactKind::RollingWithoutSpin, 0, Cylinder{0.2, 0.1, {}}, ground, none,
                      "cylinder cannot roll");
-  expectContactError(ContactKind::Rolling, 0, Mesh{"wheel.stl", Vec3::Ones(), {}}, ground, none,
+  expectContactError(ContactKind::Rolling, 0, Mesh{"wheel.stl", Vec3::Ones(), {}, {}, {}}, ground, none,
                      "collision-only");
   expectContactError(ContactKind::Rolling, 0, PointShape{}, ground, none, "point cannot roll");
   expectContactError(ContactKind::Sliding, 0, Box{}, ground, none, "no smooth contact point");

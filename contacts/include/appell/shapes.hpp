@@ -25,6 +25,7 @@
 
 #include <appell/spatial.hpp>
 
+#include <array>
 #include <span>
 #include <string>
 #include <string_view>
@@ -89,6 +90,11 @@ struct Mesh {
   std::string file;
   Vec3 scale = Vec3::Ones();
   SE3 pose;
+  /// The triangles in the mesh frame, scaled (filled by the loader; empty
+  /// when the file was not read). FCL's geometry and the vertex contacts of
+  /// a non-smooth contact (polyhedral_contact.hpp) need them.
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> triangles;
 };
 
 using Shape = std::variant<PointShape, Sphere, Ellipsoid, Disk, Torus, SphericalCap, Box, Cylinder,

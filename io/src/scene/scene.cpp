@@ -19,7 +19,15 @@ std::vector<Shape> collisionShapes(const LinkGeometry& link) {
       case GeometryType::Box: shapes.emplace_back(Box{0.5 * g.box_size, g.origin}); break;
       case GeometryType::Cylinder: shapes.emplace_back(Cylinder{g.radius, g.length, g.origin}); break;
       case GeometryType::Sphere: shapes.emplace_back(Sphere{g.radius, g.origin.p}); break;
-      case GeometryType::Mesh: shapes.emplace_back(Mesh{g.mesh_path, g.mesh_scale, g.origin}); break;
+      case GeometryType::Mesh: {
+        Mesh m{g.mesh_path, g.mesh_scale, g.origin, {}, {}};
+        if (g.mesh) {
+          m.vertices = g.mesh->vertices;
+          m.triangles = g.mesh->triangles;
+        }
+        shapes.emplace_back(std::move(m));
+        break;
+      }
     }
   }
   return shapes;
