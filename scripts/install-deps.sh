@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev          # Eigen 3.4: dense linear algebra
   libfcl-dev libccd-dev  # FCL 0.7 + libccd: collision queries
+  libqhull-dev           # Qhull: convex hulls of mesh contact shapes
   libtinyxml-dev         # TinyXML: the URDF and its <appell> scene block
   libassimp-dev          # assimp: STL / OBJ / Collada meshes
   libgtest-dev           # GoogleTest

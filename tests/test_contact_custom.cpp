@@ -164,7 +164,8 @@ TEST(ContactFactory, BadDeclarationsAreClearErrors) {
                      "cylinder cannot roll");
   expectContactError(ContactKind::Rolling, 0, Mesh{"wheel.stl", Vec3::Ones(), {}, {}, {}}, ground, none,
                      "collision-only");
-  expectContactError(ContactKind::Rolling, 0, PointShape{}, ground, none, "point cannot roll");
+  expectContactError(ContactKind::RollingWithoutSpin, 0, PointShape{}, ground, none,
+                     "point cannot roll");
   expectContactError(ContactKind::Sliding, 0, Box{}, ground, none, "no smooth contact point");
   expectContactError(ContactKind::KnifeEdge, 0, PointShape{}, ground, none,
                      "non-zero blade direction");

@@ -109,8 +109,10 @@ TEST(IoErrors, ElementsTheModelIgnoresAreStillChecked) {
   expectError("material_undefined.urdf", 3, {"<material name=\"grey\">", "<color rgba>"});
 }
 
-TEST(IoErrors, ContactOnAShapeThatCannotRoll) {
-  expectError("box_contact.urdf", 9, {"<contact name=\"bottom\">", "collision[0] (box)", "cannot roll"});
+TEST(IoErrors, KnifeEdgeOnABox) {
+  // A box touches with its corners (points): sliding or sticking, no blade.
+  expectError("box_contact.urdf", 9, {"<contact name=\"bottom\">", "collision[0] (box)",
+                                      "a box touches with its vertices", "not 'knife_edge'"});
 }
 
 TEST(IoErrors, KnifeEdgeWithoutDirection) {

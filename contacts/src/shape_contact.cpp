@@ -89,6 +89,10 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
   std::string why;
   switch (kind) {
     case ContactKind::Rolling:
+      // On a point, "rolling" is a sticking point: the body point does not
+      // slip (the vertex contacts of a box or mesh foot, vertex_contacts.hpp).
+      if (shapeType(shape).role != ShapeRole::Point && !canRoll(shape, &why)) fail(why);
+      break;
     case ContactKind::RollingWithoutSpin:
       if (!canRoll(shape, &why)) fail(why);
       break;

@@ -80,8 +80,8 @@ Shape makeCap(const ShapeParameters& p) {
 
 ShapeType describe(std::type_identity<PointShape>) {
   return {"point", {}, "a body point (blade points, sliding feet)", ShapeRole::Point,
-          "a point cannot roll (no-slip would pin it): use a knife edge or sliding contact, or "
-          "give it a radius (sphere)",
+          "a point cannot roll: kind 'rolling' pins it (a sticking point, as at a box's "
+          "corners); use a knife edge or sliding contact, or give it a radius (sphere)",
           {"xyz"}, R"(xyz="0.1 0 0")", makePoint};
 }
 ShapeType describe(std::type_identity<Sphere>) {

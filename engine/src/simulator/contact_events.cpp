@@ -69,6 +69,7 @@ void Simulator::setUpUnilateral() {
   u.q0 = q_;
   u.v0 = v_;
   u.vplus = v_;
+  u.vminus = v_;
   u.vdot = VecX::Zero(model_.nv);
   u.impulse = VecX::Zero(cdata_->m);
   u.res.vdot = VecX::Zero(model_.nv);
@@ -498,7 +499,7 @@ bool Simulator::forcePhase(std::string& error) {
   // that separates slower than rest_speed is held (its velocity projected to
   // zero): a body rocking between contacts with ever smaller plastic impacts
   // (an accumulation of impacts in finite time) comes to rest.
-  bool any = false;
+  bool any = false, held = false;
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
     auto& r = u.rows[k];
     if (!r.touching) continue;
@@ -509,10 +510,12 @@ bool Simulator::forcePhase(std::string& error) {
       if (r.was_closed) logEvent(ContactEventKind::LiftOff, k, 0, gamma, 0);
       continue;
     }
+    held = held || gamma > o.speed_tol;
     any = true;
     r.in_set = !r.lifting && (r.was_closed || r.touching_down);
   }
   if (!any) return true;
+  u.vminus = v_;
   for (int it = 0;; ++it) {
     if (it == o.max_mode_iterations) {
       error = "contact modes: no consistent set of contacts after " + std::to_string(it) +
@@ -521,7 +524,24 @@ bool Simulator::forcePhase(std::string& error) {
     }
     for (auto& r : u.rows)
       if (r.touching) cdata_->setActive(r.c, r.in_set);
+    // The velocity the trial set holds: a held contact still separates at up
+    // to rest_speed, and redundant rows (two sticking corners on one edge)
+    // give consistent accelerations only at a velocity that satisfies them
+    // all — so with a held contact, project onto the trial set (plastic)
+    // before solving. (Not otherwise: a contact that slips keeps its slip for
+    // the friction phase.)
+    v_ = u.vminus;
     evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    if (held && cdata_->m_active > 0) {
+      u.vplus = v_;
+      if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus,
+                                    u.impulse)) {
+        error = "contact modes: the velocity projection failed: " + solver_->lastError();
+        return false;
+      }
+      std::swap(v_, u.vplus);
+      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    }
     tau_.setZero();
     if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
     if (!solveDynamics(t_, q_, v_, tau_, u.res)) {

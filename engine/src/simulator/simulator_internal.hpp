@@ -103,7 +103,7 @@ enum class Crossing { None, Gap, Normal, Cone, Slip };
 
 struct UnilateralState {
   std::vector<UnilateralRow> rows;
-  VecX q0, v0, vplus, vdot, impulse;
+  VecX q0, v0, vplus, vminus, vdot, impulse;
   double t0 = 0;
   ConstrainedResult res;
   int zero_events = 0;    // consecutive events at the very start of a step

@@ -152,7 +152,7 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
     return Shape{PointShape{vec3(src, e, "point")}};
   }
   if (!has_shape) {
-    allow({"collision", "tyre_radius"});
+    allow({"collision", "tyre_radius", "rim_points"});
     return std::nullopt;
   }
   const std::string name = text(src, e, "shape");
@@ -192,6 +192,14 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
     d.tyre_radius = positive(src, e, "tyre_radius");
   }
   d.collision = text(e, "collision", "");
+  if (has(e, "rim_points")) {
+    const double n = number(src, e, "rim_points");
+    if (!(n >= 3 && n <= 256 && n == std::floor(n)))
+      fail(src, e, "'rim_points' must be a whole number from 3 to 256 (vertices of each rim polygon)");
+    if (d.tyre_radius > 0) fail(src, e, "give either 'tyre_radius' (a wheel) or 'rim_points' (a "
+                                        "cylinder standing on a face), not both");
+    d.rim_points = static_cast<int>(n);
+  }
   if (has(e, "mu")) {
     d.spec.mu = number(src, e, "mu");
     if (d.spec.mu < 0) fail(src, e, "friction coefficient 'mu' must not be negative");

@@ -25,6 +25,9 @@ struct ContactDecl {
   ContactSpec spec;
   bool explicit_shape = false;     ///< `shape=` or `point=` given
   double tyre_radius = 0;          ///< > 0: a cylinder collision is a torus rim
+  /// > 0: a cylinder collision touches with its two rims as polygons of this
+  /// many vertices (standing on a face); 0: it is a wheel rim (disk or torus).
+  int rim_points = 0;
   std::string collision;           ///< `collision=`: name or index of the geometry to use
 };
 

@@ -3,6 +3,7 @@
 #include "scene/block.hpp"
 
 #include <appell/configuration.hpp>
+#include <appell/vertex_contacts.hpp>
 
 #include <cmath>
 #include <sstream>
@@ -18,15 +19,20 @@ std::string geometryLabel(int k, const Geometry& g) {
 
 // A cylinder collision on a wheel is its rim: a thin disk in the cylinder's
 // mid-plane (or a torus whose outer radius is the cylinder's when the contact
-// gives a tyre radius). A sphere is itself. Boxes and meshes cannot roll.
+// gives a tyre radius); with `rim_points` it is a cylinder standing on a face,
+// touching with its rim polygons. A sphere is itself. Boxes and meshes touch
+// with their vertices (vertex_contacts.hpp).
 Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry& g,
                       const std::string& label) {
   const Vec3 axis = g.origin.R.col(2);
+  if (c.rim_points > 0 && g.type != GeometryType::Cylinder)
+    fail(src, c.element, "'rim_points' applies to a cylinder collision, not " + label);
   switch (g.type) {
     case GeometryType::Sphere:
       if (c.tyre_radius > 0) fail(src, c.element, "'tyre_radius' needs a cylinder, not " + label);
       return Sphere{g.radius, g.origin.p};
     case GeometryType::Cylinder:
+      if (c.rim_points > 0) return Cylinder{g.radius, g.length, g.origin};
       if (c.tyre_radius > 0) {
         if (c.tyre_radius >= g.radius)
           fail(src, c.element, "'tyre_radius' must be smaller than the cylinder radius " +
@@ -35,11 +41,16 @@ Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry
       }
       return Disk{g.radius, g.origin.p, axis};
     case GeometryType::Box:
-    case GeometryType::Mesh:
-      break;
+      if (c.tyre_radius > 0) fail(src, c.element, "'tyre_radius' needs a cylinder, not " + label);
+      return Box{0.5 * g.box_size, g.origin};
+    case GeometryType::Mesh: {
+      if (c.tyre_radius > 0) fail(src, c.element, "'tyre_radius' needs a cylinder, not " + label);
+      if (!g.mesh) fail(src, c.element, label + ": the mesh '" + g.mesh_path + "' was not loaded");
+      Mesh m{g.mesh_path, g.mesh_scale, g.origin, g.mesh->vertices, g.mesh->triangles};
+      return m;
+    }
   }
-  fail(src, c.element, label + " cannot roll: it has edges or facets, no unique contact point; "
-                       "give a smooth 'shape' (" + rollingShapeNames() + ") or a 'point'");
+  fail(src, c.element, label + ": unknown geometry type");
 }
 
 Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometry& geo,
@@ -148,16 +159,23 @@ void buildSceneContents(const XmlSource& src, const AppellBlock& block, const Lo
     ContactOrigin origin;
     origin.line = c.element->Row();
     spec.shape = contactShape(src, c, scene.geometry[spec.body], origin.shape_source);
-    std::shared_ptr<const ShapeContact> contact;
+    std::vector<std::shared_ptr<ShapeContact>> made;
     try {
-      contact = makeContact(spec);
+      if (isSmoothContactShape(spec.shape))
+        made.push_back(makeContact(spec));
+      else
+        made = makeVertexContacts(spec, c.rim_points > 0 ? c.rim_points : 16);
     } catch (const std::invalid_argument& e) {
       fail(src, c.element, std::string(e.what()) + " (shape: " + shapeName(spec.shape) + " from " +
                                origin.shape_source + ")");
     }
-    scene.constraints.push_back(contact);
-    scene.contacts.push_back(std::move(contact));
-    scene.contact_origins.push_back(std::move(origin));
+    for (int k = 0; k < static_cast<int>(made.size()); ++k) {
+      ContactOrigin o = origin;
+      if (made.size() > 1) o.shape_source += ", vertex " + std::to_string(k);
+      scene.constraints.push_back(made[k]);
+      scene.contacts.push_back(std::move(made[k]));
+      scene.contact_origins.push_back(std::move(o));
+    }
   }
   if (block.limits_enabled && options.joint_limits) {
     for (int j = 0; j < model.nbodies; ++j) {

@@ -1,0 +1,262 @@
+// Non-smooth shapes on a support (vertex_contacts.hpp): a box, a mesh foot
+// and a standing cylinder touch with their vertices, which make and break as
+// unilateral point contacts.
+#include <gtest/gtest.h>
+
+#include <appell/simulator.hpp>
+#include <appell/urdf.hpp>
+#include <appell/vertex_contacts.hpp>
+
+#include "scene.hpp"
+#include "simulation_helpers.hpp"
+
+#include <cmath>
+#include <set>
+
+using namespace appell;
+using namespace appell::scenes;
+
+namespace {
+
+constexpr double kG = 9.81;
+const Vec3 kHalf(0.2, 0.1, 0.05);
+constexpr double kMass = 2.0;
+
+struct DroppedBox {
+  Model model;
+  ConstraintList constraints;
+  VecX q0, v0;
+};
+
+// A uniform box whose lowest corner starts `h` above the plane z = 0,
+// rotated by R, all corners declared as point contacts of `kind`.
+DroppedBox droppedBox(double h, const Mat3& R, ContactKind kind, double restitution = 0) {
+  ModelBuilder b;
+  const Vec3 d = 2 * kHalf;
+  const Vec3 I = kMass / 12 * Vec3(d.y() * d.y() + d.z() * d.z(), d.x() * d.x() + d.z() * d.z(),
+                                   d.x() * d.x() + d.y() * d.y());
+  b.addBody("box", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+            principalInertia(kMass, I), "free");
+  DroppedBox s;
+  s.model = b.build();
+  ContactSpec spec;
+  spec.kind = kind;
+  spec.body = 0;
+  spec.shape = Box{kHalf, SE3::Identity()};
+  spec.support = Support{Plane{}, StaticMotion{}, "ground"};
+  spec.restitution = restitution;
+  spec.options.name = "box";
+  for (auto& c : makeVertexContacts(spec)) s.constraints.push_back(c);
+  double lowest = INFINITY;
+  for (const Vec3& v : contactVertices(spec.shape)) lowest = std::min(lowest, (R * v).z());
+  s.q0 = neutralConfiguration(s.model);
+  setFloatingPose(s.q0, 0, Vec3(0, 0, h - lowest), R);
+  s.v0 = VecX::Zero(s.model.nv);
+  return s;
+}
+
+double normalForceSum(const Simulator& sim) {
+  double sum = 0;
+  const ConstraintData& cd = sim.constraintData();
+  for (int c = 0; c < static_cast<int>(sim.constraints().size()); ++c)
+    if (sim.isClosed(c))
+      sum += sim.lambda()[cd.offset[c] + sim.constraints()[c]->unilateralRow()];
+  return sum;
+}
+
+}  // namespace
+
+// Protects: a box dropped flat lands on its four lower corners at the
+// free-fall time, in one mode decision (four touchdowns at one instant), and
+// then rests: the four redundant normal rows carry its weight exactly, the
+// upper corners stay open, nothing drifts — for frictionless (sliding) and
+// sticking (rolling) corners, in every formulation.
+TEST(ContactVertices, BoxDroppedFlatRestsOnItsFourCorners) {
+  const double h = 0.1;
+  const double t_star = std::sqrt(2 * h / kG);
+  for (ContactKind kind : {ContactKind::Sliding, ContactKind::Rolling}) {
+    for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
+      DroppedBox s = droppedBox(h, Mat3::Identity(), kind);
+      ASSERT_EQ(s.constraints.size(), 8u);
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                    IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+      const auto events = appell::test::advanceCollecting(sim, 1.0);
+      std::set<int> landed;
+      for (const ContactEvent& e : events) {
+        EXPECT_EQ(e.kind, ContactEventKind::Touchdown) << toString(kind) << " " << toString(f);
+        EXPECT_NEAR(e.t, t_star, 1e-10);
+        landed.insert(e.constraint);
+      }
+      EXPECT_EQ(landed.size(), 4u) << "the four lower corners land, once each";
+      for (int c = 0; c < 8; ++c) {
+        const bool lower = (contactVertices(Box{kHalf, SE3::Identity()})[c]).z() < 0;
+        EXPECT_EQ(sim.isClosed(c), lower) << "corner " << c;
+      }
+      EXPECT_NEAR(sim.q()[2], kHalf.z(), 1e-9) << "resting on the plane";
+      EXPECT_LT(sim.v().norm(), 1e-9) << "at rest";
+      EXPECT_NEAR(normalForceSum(sim), kMass * kG, 1e-8) << "the corners carry the weight";
+      EXPECT_NEAR(sim.impactEnergyLoss(), kMass * kG * h, 1e-8)
+          << "a plastic landing takes all the kinetic energy";
+    }
+  }
+}
+
+// Protects: a tilted box lands on one edge first (two corners at the
+// free-fall time of that edge), pivots, and its other edge lands later; the
+// energy never grows (E + impact losses is conserved between and through
+// events), and it ends at rest on four corners.
+TEST(ContactVertices, TiltedBoxLandsOnAnEdgeThenFallsFlat) {
+  const double h = 0.05;
+  const Mat3 R = axisAngle(Vec3::UnitX(), 0.2);
+  DroppedBox s = droppedBox(h, R, ContactKind::Rolling);
+  Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
+                IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+  ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+  const double E0 = sim.energy();
+  std::vector<ContactEvent> all;
+  double worst = 0;
+  while (sim.time() < 2.0 - 1e-12) {
+    const StepStatus st = sim.step(1e-2);
+    ASSERT_TRUE(st.ok) << st.message;
+    all.insert(all.end(), sim.events().begin(), sim.events().end());
+    worst = std::max(worst, std::abs(sim.energy() + sim.impactEnergyLoss() - E0));
+  }
+  ASSERT_GE(all.size(), 4u);
+  EXPECT_EQ(all[0].kind, ContactEventKind::Touchdown);
+  EXPECT_NEAR(all[0].t, std::sqrt(2 * h / kG), 1e-10) << "the lower edge lands first";
+  EXPECT_NEAR(all[1].t, all[0].t, 1e-12) << "both corners of that edge at once";
+  bool later = false;
+  for (const ContactEvent& e : all) later |= e.t > all[0].t + 1e-3;
+  EXPECT_TRUE(later) << "the other edge lands after the box pivots";
+  EXPECT_LT(worst, 1e-7) << "E + impact losses is conserved";
+  EXPECT_NEAR(sim.q()[2], kHalf.z(), 1e-8);
+  EXPECT_LT(sim.v().norm(), 1e-8);
+  EXPECT_NEAR(normalForceSum(sim), kMass * kG, 1e-7);
+}
+
+// Protects the candidate vertices: a box's 8 corners, a cylinder's two rim
+// polygons, the hull vertices of a mesh (an interior vertex is dropped), and
+// refusals that name the shape.
+TEST(ContactVertices, CandidateVerticesOfEachShape) {
+  EXPECT_EQ(contactVertices(Box{kHalf, SE3::Identity()}).size(), 8u);
+  const auto rim = contactVertices(Cylinder{0.1, 0.04, SE3::Identity()}, 12);
+  ASSERT_EQ(rim.size(), 24u);
+  for (const Vec3& v : rim) {
+    EXPECT_NEAR(v.head<2>().norm(), 0.1, 1e-15);
+    EXPECT_NEAR(std::abs(v.z()), 0.02, 1e-15);
+  }
+  // A tetrahedron's faces with a fifth, interior vertex used by extra faces.
+  Mesh m{"foot.stl", Vec3::Ones(), SE3::Identity(), {}, {}};
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.1, 0.1, 0.1}};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}, {0, 1, 4}};
+  const auto hull = contactVertices(m);
+  EXPECT_EQ(hull.size(), 4u) << "the interior vertex is not a candidate";
+  for (const Vec3& v : hull) EXPECT_GT((v - Vec3(0.1, 0.1, 0.1)).norm(), 0.1);
+  Mesh flat = m;
+  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0.5, 0.5, 0}};
+  flat.triangles = {{0, 1, 2}, {1, 3, 2}};
+  auto message = [](auto&& make) {
+    try {
+      make();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_NE(message([&] { contactVertices(flat); }).find("mesh 'foot.stl': its vertices span no volume"),
+            std::string::npos);
+  EXPECT_NE(message([] { contactVertices(Sphere{0.1, Vec3::Zero()}); }).find("sphere:"),
+            std::string::npos);
+  ContactSpec knife;
+  knife.kind = ContactKind::KnifeEdge;
+  knife.body = 0;
+  knife.shape = Box{kHalf, SE3::Identity()};
+  knife.options.name = "crate";
+  EXPECT_NE(message([&] { makeVertexContacts(knife); }).find("contact 'crate': a box touches with its vertices"),
+            std::string::npos);
+}
+
+namespace {
+
+// Runs a loaded scene for `duration` with tight settings; returns the worst
+// |E + impact losses − E0| seen at the ends of steps.
+double runToRest(Simulator& sim, const Scene& scene, double duration) {
+  EXPECT_TRUE(sim.setState(0, scene.q0, scene.v0)) << sim.lastStateError();
+  const double E0 = sim.energy();
+  double worst = 0;
+  while (sim.time() < duration - 1e-12) {
+    const StepStatus st = sim.step(1e-2);
+    EXPECT_TRUE(st.ok) << st.message;
+    if (!st.ok) break;
+    worst = std::max(worst, std::abs(sim.energy() + sim.impactEnergyLoss() - E0));
+  }
+  return worst;
+}
+
+}  // namespace
+
+// Protects the scene-file path: a box collision under <contact> becomes its
+// eight corners (named, with their origin), and the tossed, tumbling crate of
+// examples/tumbling_crate — a cascade of corner impacts, each lifting the
+// corner before — comes to rest flat on four corners that carry its weight,
+// with E + impact losses conserved throughout.
+TEST(ContactVertices, TumblingCrateExampleComesToRestOnAFace) {
+  Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/tumbling_crate/tumbling_crate.urdf");
+  ASSERT_EQ(scene.contacts.size(), 8u);
+  EXPECT_EQ(scene.contacts[5]->name(), "corners/v5");
+  EXPECT_NE(scene.contact_origins[5].shape_source.find("collision[0] (box), vertex 5"),
+            std::string::npos);
+  Simulator sim(scene.model, scene.constraints,
+                makeSolver(Formulation::Tree, scene.model, scene.constraints),
+                IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+  const double drift = runToRest(sim, scene, 2.0);
+  EXPECT_LT(drift, 1e-8) << "E + impact losses is conserved";
+  EXPECT_LT(sim.v().norm(), 1e-9) << "at rest";
+  int closed = 0;
+  for (int c = 0; c < 8; ++c) closed += sim.isClosed(c);
+  EXPECT_EQ(closed, 4) << "flat on one face";
+  const double z = sim.q()[2];
+  EXPECT_TRUE(std::abs(z - 0.1) < 1e-9 || std::abs(z - 0.15) < 1e-9 || std::abs(z - 0.2) < 1e-9)
+      << "the centre rests at a half-extent above the floor, z = " << z;
+  EXPECT_NEAR(normalForceSum(sim), 3 * kG, 1e-7);
+}
+
+// Protects rim_points: a cylinder collision declared to stand on its face
+// touches with its rim polygons; dropped flat it lands on all of its lower
+// rim's vertices at the free-fall time and rests at half its length.
+TEST(ContactVertices, CylinderStandingOnItsFaceLandsOnItsRim) {
+  const std::string urdf = R"(<?xml version="1.0"?>
+<robot name="puck">
+  <link name="puck">
+    <inertial><mass value="0.5"/><inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.003"/></inertial>
+    <collision><geometry><cylinder radius="0.1" length="0.04"/></geometry></collision>
+  </link>
+  <appell>
+    <support name="floor" type="plane"/>
+    <contact name="base" link="puck" kind="sliding" support="floor" rim_points="6"/>
+    <initial><joint name="root_joint" xyz="0 0 0.12"/></initial>
+  </appell>
+</robot>)";
+  Scene scene = loadSceneFromString(urdf, ".");
+  ASSERT_EQ(scene.contacts.size(), 12u);
+  Simulator sim(scene.model, scene.constraints,
+                makeSolver(Formulation::Multipliers, scene.model, scene.constraints),
+                IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+  ASSERT_TRUE(sim.setState(0, scene.q0, scene.v0)) << sim.lastStateError();
+  const auto events = appell::test::advanceCollecting(sim, 0.5);
+  ASSERT_EQ(events.size(), 6u) << "the six vertices of the lower rim";
+  for (const ContactEvent& e : events) EXPECT_NEAR(e.t, std::sqrt(2 * 0.1 / kG), 1e-10);
+  EXPECT_NEAR(sim.q()[2], 0.02, 1e-9);
+  EXPECT_NEAR(normalForceSum(sim), 0.5 * kG, 1e-8);
+  try {
+    loadSceneFromString(std::string(urdf).replace(urdf.find("rim_points=\"6\""), 14,
+                                                  "rim_points=\"2\""),
+                        ".");
+    ADD_FAILURE() << "two rim points accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("'rim_points' must be a whole number from 3"),
+              std::string::npos)
+        << e.what();
+  }
+}
