@@ -13,6 +13,8 @@ PACKAGES=(
   libgtest-dev           # GoogleTest
   libbenchmark-dev       # Google Benchmark
   gnuplot-nox            # figures of the benchmark reports
+  python3-dev pybind11-dev        # the Python bindings (python/)
+  python3-numpy python3-pytest    # their arrays and their tests
 )
 
 bash "$(dirname "$0")/apt-install.sh" install-deps "${PACKAGES[@]}"

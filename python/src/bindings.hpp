@@ -1,0 +1,34 @@
+// The pieces of the _appell extension module, one file each: scene loading
+// and names (scene_bindings.cpp), simulation (simulation_bindings.cpp),
+// equilibria and linearization (analysis_bindings.cpp), and the helpers they
+// share.
+#pragma once
+
+#include <appell/scene.hpp>
+
+#include <pybind11/pybind11.h>
+
+#include <string>
+#include <vector>
+
+namespace appell::python {
+
+namespace py = pybind11;
+
+void bindScene(py::module_& m);
+void bindSimulation(py::module_& m);
+void bindAnalysis(py::module_& m);
+
+/// Index of a constraint given by index (negative from the end, as Python
+/// does) or by name; IndexError / KeyError otherwise.
+int constraintIndex(const Scene& scene, py::handle which);
+/// Index of a body given by index or name; IndexError / KeyError otherwise.
+int bodyIndex(const Scene& scene, py::handle which);
+/// The scene's constant joint forces when it has them (size nv), else empty.
+VecX sceneTau(const Scene& scene);
+
+/// Names of the position (nq) or velocity (nv) coordinates, as the CSV
+/// columns name them without their "q:" / "v:" prefix.
+std::vector<std::string> coordinateNames(const Model& model, bool velocities);
+
+}  // namespace appell::python

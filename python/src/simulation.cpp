@@ -1,0 +1,162 @@
+#include "simulation.hpp"
+
+#include <appell/constrained_dynamics.hpp>
+#include <appell/kinematics.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace appell::python {
+
+void Recording::sample(const Simulator& sim) {
+  t.push_back(sim.time());
+  q.push_back(sim.q());
+  v.push_back(sim.v());
+  lambda.push_back(sim.lambda());
+  energy.push_back(sim.energy());
+  velocity_residual.push_back(sim.velocityResidual());
+  gap_residual.push_back(sim.gapResidual());
+}
+
+namespace {
+
+double positiveOr(double value, double fallback, const char* what) {
+  if (std::isnan(value)) throw std::invalid_argument(std::string(what) + " is NaN");
+  return value > 0 ? value : fallback;
+}
+
+}  // namespace
+
+Simulation::Simulation(std::shared_ptr<const Scene> scene, const SimulationOptions& options)
+    : scene_(std::move(scene)), options_(options) {
+  if (!scene_) throw std::invalid_argument("Simulation: no scene");
+  const Scene& s = *scene_;
+  const SimulationSettings& set = s.settings;
+  const IntegratorType integrator =
+      integratorFromString(options.integrator.empty() ? set.integrator : options.integrator);
+  const Formulation formulation =
+      formulationFromString(options.formulation.empty() ? set.formulation : options.formulation);
+  dt_ = positiveOr(options.dt, set.dt, "dt");
+  IntegratorOptions io;
+  io.rtol = positiveOr(options.rtol, set.tol, "rtol");
+  io.atol = positiveOr(options.atol, io.rtol * 1e-2, "atol");
+  io.h_min = positiveOr(options.h_min, io.h_min, "h_min");
+  io.h_max = positiveOr(options.h_max, io.h_max, "h_max");
+  SimulatorOptions so;
+  so.project_positions = options.project_positions;
+  so.project_velocities = options.project_velocities;
+  so.contacts.enabled = options.contact_events;
+  sim_ = std::make_unique<Simulator>(s.model, s.constraints,
+                                     makeSolver(formulation, s.model, s.constraints), integrator,
+                                     io, so);
+  // The scene's constant joint forces (<effort>), as makeSimulator sets them.
+  if (s.tau.size() == s.model.nv) {
+    const VecX tau = s.tau;
+    sim_->setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
+  }
+  data_ = std::make_unique<Data>(s.model);
+  cdata_ = std::make_unique<ConstraintData>(s.model, s.constraints, DenseRows::None);
+  setState(0.0, s.q0, s.v0);
+}
+
+bool Simulation::setState(double t, const VecX& q, const VecX& v) {
+  const bool ok = sim_->setState(t, q, v);
+  events_.clear();
+  collectEvents();
+  return ok;
+}
+
+void Simulation::collectEvents() {
+  for (const ContactEvent& e : sim_->events())
+    events_.push_back({e, scene_->constraints[e.constraint]->name()});
+}
+
+StepStatus Simulation::step(double h) {
+  events_.clear();
+  const StepStatus st = sim_->step(h > 0 ? h : dt_);
+  collectEvents();
+  return st;
+}
+
+StepStatus Simulation::advanceTo(double t_end, double h, Recording* record, int every) {
+  if (h <= 0) h = dt_;
+  if (!std::isfinite(h) || !std::isfinite(t_end))
+    throw std::invalid_argument("advance_to: h must be positive and t_end finite");
+  if (every < 1) throw std::invalid_argument("advance_to: every must be at least 1");
+  events_.clear();
+  if (record) record->sample(*sim_);
+  // The loop of Simulator::advanceTo, one step() at a time so that every
+  // step's events are kept and the states can be recorded.
+  StepStatus st;
+  const double eps = 1e-12 * std::max(1.0, std::abs(t_end));
+  const bool adaptive = sim_->integrator().adaptive();
+  double h_suggest = h;
+  long n = 0;
+  bool sampled_last = true;
+  while (t_end - sim_->time() > eps) {
+    const double remaining = t_end - sim_->time();
+    const double want = adaptive ? h_suggest : h;
+    const bool last = want >= remaining - eps;
+    st = sim_->step(last ? remaining : want);
+    if (!st.ok) break;
+    collectEvents();
+    if (adaptive && (!last || st.h_taken < remaining)) h_suggest = st.h_next;
+    sampled_last = false;
+    if (record && ++n % every == 0) {
+      record->sample(*sim_);
+      sampled_last = true;
+    }
+  }
+  if (record && !sampled_last) record->sample(*sim_);
+  return st;
+}
+
+void Simulation::rowResiduals(VecX& residual, VecX& gap) {
+  const Scene& s = *scene_;
+  const VecX& q = sim_->q();
+  const VecX& v = sim_->v();
+  evaluateConstraintRows(s.model, *data_, s.constraints, *cdata_, sim_->time(), q, v);
+  residual.resize(cdata_->m);
+  for (size_t k = 0; k < s.constraints.size(); ++k) {
+    const Constraint& c = *s.constraints[k];
+    const RowBlock& blk = cdata_->blocks[k];
+    const int o = cdata_->offset[k];
+    if (c.jointSpace()) {
+      for (int i = 0; i < c.rows(); ++i) residual[o + i] = blk.A_joint.row(i).dot(v) + cdata_->b[o + i];
+      continue;
+    }
+    // wₐ·Vₐ − w_b·V_b + b with world-frame body velocities (constraint.hpp).
+    const int a = c.bodyA(), b = c.bodyB();
+    const Vec6 Va = a >= 0 ? Vec6(data_->oMi[a].act(data_->v[a])) : Vec6::Zero();
+    const Vec6 Vb = b >= 0 ? Vec6(data_->oMi[b].act(data_->v[b])) : Vec6::Zero();
+    for (int i = 0; i < c.rows(); ++i) {
+      double value = cdata_->b[o + i];
+      if (a >= 0) value += blk.Wa.row(i).dot(Va);
+      if (b >= 0) value -= blk.Wb.row(i).dot(Vb);
+      residual[o + i] = value;
+    }
+  }
+  gap = cdata_->gap;
+}
+
+Eigen::Matrix4d Simulation::bodyPose(int body) {
+  if (body < 0 || body >= scene_->model.nbodies)
+    throw std::out_of_range("no body " + std::to_string(body) + " (the model has " +
+                            std::to_string(scene_->model.nbodies) + ")");
+  forwardKinematics(scene_->model, *data_, sim_->q());
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = data_->oMi[body].R;
+  T.topRightCorner<3, 1>() = data_->oMi[body].p;
+  return T;
+}
+
+Simulation::Guard::Guard(const Simulation& s) : s_(s) {
+  if (s_.busy_.exchange(true))
+    throw std::runtime_error(
+        "this Simulation is in use by another thread (step each Simulation on one thread)");
+}
+
+Simulation::Guard::~Guard() { s_.busy_.store(false); }
+
+}  // namespace appell::python

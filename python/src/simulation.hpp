@@ -1,0 +1,104 @@
+// A scene's Simulator as the Python module sees it (plain C++, no pybind11):
+// the Simulator keeps a reference to the scene's model, so the simulation owns
+// a shared pointer to the scene; stepping loops collect the contact events of
+// every step (Simulator::events() holds only the last step's) and can record
+// the states they pass; row residuals, body poses and the busy flag that
+// guards a simulation stepped on one thread from being used on another.
+#pragma once
+
+#include <appell/scene.hpp>
+#include <appell/simulator.hpp>
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace appell::python {
+
+/// How to simulate a scene. Empty names and non-positive numbers mean "the
+/// scene's own setting" (SimulationSettings of its <simulation> element).
+struct SimulationOptions {
+  std::string integrator;          ///< a name of integratorTable()
+  std::string formulation;         ///< a name of formulationTable()
+  double dt = 0;                   ///< fixed step / first adaptive step
+  double rtol = 0;                 ///< adaptive: relative tolerance (default: scene tol)
+  double atol = 0;                 ///< adaptive: absolute tolerance (default: rtol / 100)
+  double h_min = 1e-14;
+  double h_max = 0.1;
+  bool project_positions = true;
+  bool project_velocities = true;
+  bool contact_events = true;      ///< unilateral contacts may open (ContactEventOptions)
+};
+
+/// The states a stepping loop passed: one row per sample.
+struct Recording {
+  std::vector<double> t, energy, velocity_residual, gap_residual;
+  std::vector<VecX> q, v, lambda;
+  void sample(const Simulator& sim);
+};
+
+/// A contact event with its constraint's name.
+struct NamedEvent {
+  ContactEvent event;
+  std::string constraint_name;
+};
+
+class Simulation {
+ public:
+  /// Throws std::invalid_argument for unknown names or bad numbers (as the
+  /// C++ API does). The state starts at (0, scene.q0, scene.v0).
+  Simulation(std::shared_ptr<const Scene> scene, const SimulationOptions& options);
+
+  const Scene& scene() const { return *scene_; }
+  const std::shared_ptr<const Scene>& scenePtr() const { return scene_; }
+  Simulator& simulator() { return *sim_; }
+  const Simulator& simulator() const { return *sim_; }
+  double dt() const { return dt_; }
+  const SimulationOptions& options() const { return options_; }
+
+  /// Simulator::setState; returns its result (false: lastStateError()).
+  bool setState(double t, const VecX& q, const VecX& v);
+  /// One step (h ≤ 0: dt()). Clears and refills events().
+  StepStatus step(double h);
+  /// Steps until t_end as Simulator::advanceTo does (fixed steps of h, or the
+  /// adaptive suggestion), collecting every step's events; when `record` is
+  /// given, samples the start and every `every`-th step and the end.
+  StepStatus advanceTo(double t_end, double h, Recording* record = nullptr, int every = 1);
+  /// Events of the last step() / advanceTo() / setState(), in time order.
+  const std::vector<NamedEvent>& events() const { return events_; }
+
+  /// A v + b of every row at the current state (open constraints included),
+  /// and the holonomic gap of every row (0 where not holonomic).
+  void rowResiduals(VecX& residual, VecX& gap);
+  /// Pose of a body in the world: 4 × 4 homogeneous matrix.
+  Eigen::Matrix4d bodyPose(int body);
+
+  /// Marks the simulation in use for the lifetime of a Guard; a second
+  /// guard (another thread) throws std::runtime_error instead of racing.
+  class Guard {
+   public:
+    explicit Guard(const Simulation& s);
+    ~Guard();
+    Guard(const Guard&) = delete;
+    Guard& operator=(const Guard&) = delete;
+
+   private:
+    const Simulation& s_;
+  };
+
+ private:
+  void collectEvents();
+
+  std::shared_ptr<const Scene> scene_;
+  SimulationOptions options_;
+  double dt_ = 0;
+  std::unique_ptr<Simulator> sim_;
+  std::vector<NamedEvent> events_;
+  // Own workspace for reports, so they never touch the simulator's.
+  std::unique_ptr<Data> data_;
+  std::unique_ptr<ConstraintData> cdata_;
+  mutable std::atomic<bool> busy_{false};
+};
+
+}  // namespace appell::python

@@ -1,0 +1,202 @@
+"""The Python surface itself: names, state in and out, errors carrying the
+C++ messages, events, joint forces, threads."""
+
+import math
+import threading
+
+import numpy as np
+import pytest
+
+import appell
+from conftest import example, tight_simulation
+
+DISK = example("rolling_disk/rolling_disk.urdf")
+BALL = example("bouncing_ball/bouncing_ball.urdf")
+
+
+def test_names_and_sizes():
+    scene = appell.load_scene(DISK)
+    assert (scene.nq, scene.nv, scene.nbodies, scene.nrows) == (7, 6, 1, 3)
+    assert scene.body_names == ["disk"]
+    assert scene.joint_names == ["root_joint"] and scene.joint_types == ["floating"]
+    assert scene.position_names[0] == "root_joint.x" and scene.position_names[-1] == "root_joint.qw"
+    assert scene.velocity_names == ["root_joint." + c for c in ("wx", "wy", "wz", "vx", "vy", "vz")]
+    assert scene.constraint_names == scene.contact_names == ["rim"]
+    assert scene.row_labels == ["rim.tangent1", "rim.tangent2", "rim.normal"]
+    assert scene.row_kinds == ["tangent1", "tangent2", "normal"]
+    assert scene.constraint_rows("rim") == [0, 1, 2] and scene.row_index(0, "normal") == 2
+    assert scene.settings.integrator == "dopri5" and scene.settings.duration == 5
+    assert [e["name"] for e in appell.integrators()] == ["euler", "rk4", "dopri5"]
+    assert "tree" in [f["name"] for f in appell.formulations()]
+    assert scene.q0.shape == (7,) and scene.q0.dtype == np.float64
+
+
+def test_state_round_trip():
+    scene = appell.load_scene(DISK)
+    sim = appell.Simulation(scene, integrator="rk4", dt=1e-3)
+    assert (sim.integrator, sim.formulation, sim.dt) == ("rk4", "tree", 1e-3)
+    assert np.array_equal(sim.q, scene.q0) and np.array_equal(sim.v, scene.v0) and sim.t == 0
+    sim.advance_to(0.1)
+    q, v = sim.q, sim.v
+    sim.set_state(t=5.0)
+    assert sim.t == 5.0 and np.array_equal(sim.q, q) and np.array_equal(sim.v, v)
+    q[0] += 1.0                       # a copy: the simulation is not changed
+    assert sim.q[0] != q[0]
+    sim.set_state(q=scene.q0, v=scene.v0, t=0.0)
+    assert np.array_equal(sim.q, scene.q0)
+    assert sim.counters["steps"] == 100
+
+
+def test_errors_keep_the_cpp_message(tmp_path):
+    with pytest.raises(appell.SceneError, match="cannot open file"):
+        appell.load_scene(tmp_path / "missing.urdf")
+    bad = (tmp_path / "bad.urdf")
+    bad.write_text("<robot name='x'><link name='a'/><appell><contact name='c' link='nope' "
+                   "kind='rolling'/></appell></robot>")
+    with pytest.raises(appell.SceneError, match="bad.urdf"):
+        appell.load_scene(bad)
+    scene = appell.load_scene(DISK)
+    with pytest.raises(ValueError, match="unknown integrator 'leapfrog'"):
+        appell.Simulation(scene, integrator="leapfrog")
+    with pytest.raises(ValueError, match="unknown formulation"):
+        appell.Simulation(scene, formulation="lagrange")
+    sim = appell.Simulation(scene)
+    with pytest.raises(ValueError, match="q must have size nq = 7"):
+        sim.set_state(q=np.zeros(3))
+    with pytest.raises(ValueError, match="non-finite"):
+        sim.set_state(v=np.full(6, np.nan))
+    with pytest.raises(ValueError, match="h must be positive"):
+        sim.advance_to(math.inf)
+    with pytest.raises(KeyError):
+        sim.constraint_lambdas("nope")
+    with pytest.raises(IndexError):
+        sim.body_pose(3)
+    with pytest.raises(ValueError, match="size 7"):
+        scene.q0 = np.zeros(2)
+    with pytest.raises(ValueError):       # linearize: bad cyclic index (std::invalid_argument)
+        appell.linearize(scene, cyclic=[42])
+
+
+def test_failed_step_raises_or_reports():
+    scene = appell.load_scene(DISK)
+    sim = appell.Simulation(scene, integrator="rk4", dt=0.01)
+    sim.set_joint_forces(lambda t, q, v: np.full(6, np.inf))
+    with pytest.raises(appell.SimulationError):
+        sim.step()
+    status = sim.step(check=False)
+    assert not status and status.message
+    assert sim.t == 0.0                   # the last good state is kept
+
+
+def test_joint_forces_constant_and_callable():
+    scene = appell.load_scene(DISK)
+    push = np.array([0, 0, 0.2, 0, 0, 0])          # a torque about the axle
+    a = appell.Simulation(scene, integrator="rk4", dt=1e-3)
+    b = appell.Simulation(scene, integrator="rk4", dt=1e-3)
+    a.set_joint_forces(push)
+    calls = []
+    b.set_joint_forces(lambda t, q, v: calls.append(t) or push)
+    a.advance_to(0.2)
+    b.advance_to(0.2)
+    assert calls and np.array_equal(a.q, b.q)
+    free = appell.Simulation(scene, integrator="rk4", dt=1e-3)
+    free.advance_to(0.2)
+    assert np.max(np.abs(free.q - a.q)) > 1e-4
+    # A Python error inside the callback is raised by the step, unchanged.
+    # set_joint_forces evaluates the current state with the new forces, so
+    # the error shows there, and again at the next step.
+    with pytest.raises(ZeroDivisionError):
+        b.set_joint_forces(lambda t, q, v: 1 / 0)
+    t = b.t
+    with pytest.raises(ZeroDivisionError):
+        b.step()
+    assert b.t == t
+    b.set_joint_forces(None)
+    b.step()
+
+
+def test_bounce_events():
+    scene = appell.load_scene(BALL)
+    sim = tight_simulation(scene)
+    assert sim.closed == [False]                    # in flight
+    traj = sim.record(1.2)
+    kinds = [e.kind for e in traj.events]
+    assert kinds and kinds[0] == "bounce"
+    first = traj.events[0]
+    assert first.name == "floor_contact" and first.constraint == 0
+    # Dropped from a height of 1 m: it lands at √(2 h / g), at √(2 g h).
+    assert first.t == pytest.approx(math.sqrt(2 / 9.81), abs=1e-8)
+    assert first.speed_before == pytest.approx(-math.sqrt(2 * 9.81), rel=1e-8)
+    assert first.speed_after == pytest.approx(0.6 * math.sqrt(2 * 9.81), rel=1e-8)
+    assert first.normal_impulse > 0
+    assert sim.impact_energy_loss > 0
+    # E + impact losses is conserved (a passive scene).
+    assert sim.energy + sim.impact_energy_loss == pytest.approx(traj.energy[0], rel=1e-8)
+    assert sim.counters["events"] == len(traj.events)
+
+
+def run_disk(scene, t_end):
+    sim = appell.Simulation(scene, integrator="rk4", dt=1e-3)
+    sim.advance_to(t_end)
+    return sim.q
+
+
+def test_threads_give_the_serial_results():
+    scene = appell.load_scene(DISK)
+    serial = run_disk(scene, 0.5)
+    results = [None] * 4
+
+    def work(i):
+        results[i] = run_disk(scene, 0.5)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        assert np.array_equal(r, serial)
+
+
+def test_one_simulation_on_two_threads_is_refused():
+    scene = appell.load_scene(DISK)
+    sim = appell.Simulation(scene, integrator="rk4", dt=1e-4)
+    started = threading.Event()
+    errors = []
+
+    def slow():
+        started.set()
+        sim.advance_to(2.0)
+
+    worker = threading.Thread(target=slow)
+    worker.start()
+    started.wait()
+    # While the worker steps (the GIL released), reading the state is refused.
+    for _ in range(2000):
+        try:
+            sim.q
+        except RuntimeError as e:
+            errors.append(str(e))
+            break
+    worker.join()
+    assert errors and "in use by another thread" in errors[0]
+    assert sim.t == 2.0
+
+
+def test_linearize_takes_cyclic_coordinates_by_name_or_index():
+    # The upright disk rolling straight along x (consistent: no slip at the rim).
+    scene = appell.load_scene(DISK)
+    v = np.array([0.0, 0.0, -5.0, 1.5, 0.0, 0.0])
+    sim = appell.Simulation(scene)
+    sim.set_state(v=v)
+    assert np.max(np.abs(sim.row_residuals()[0])) < 1e-15
+    names = ["root_joint.wy", "root_joint.wz", "root_joint.vx", "root_joint.vy"]
+    by_name = appell.linearize(scene, scene.q0, v, cyclic=names)
+    by_index = appell.linearize(scene, scene.q0, v, cyclic=[1, 2, 3, 4])
+    assert by_name.retained == by_index.retained == [0, 5]
+    assert np.array_equal(by_name.matrix, by_index.matrix)
+    assert by_name.constraint_residual < 1e-12
+    # θ̇ at the reference: ω and the world velocity of the origin (here v itself).
+    assert np.allclose(by_name.drift, v, atol=1e-15)
+    with pytest.raises(KeyError, match="root_joint.spin"):
+        appell.linearize(scene, cyclic=["root_joint.spin"])
