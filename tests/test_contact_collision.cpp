@@ -147,3 +147,75 @@ TEST(ContactCollision, UnrepresentablePairsAreRefusedByName) {
                 .find("support 'bowl': FCL cannot represent it (the inside of a sphere"),
             std::string::npos);
 }
+
+// Protects the terrain's candidate searches (each widens its box until the
+// best feature must be inside): over a bumpy 32 × 32 grid, at 400 random
+// positions from touching to 2 m above,
+//  - a sphere's gap is FCL's exact sphere–mesh distance (FCL's own traversal
+//    of the hierarchy, sphere–triangle in closed form), its support point
+//    FCL's nearest point — on a face, an edge or a vertex (terrain_sphere.cpp);
+//  - an ellipsoid's gap is the brute-force one of the face model: every face
+//    tried as a plane, the smallest gap among faces whose triangle holds the
+//    foot of the contact point (singular where none does).
+TEST(ContactCollision, TerrainSearchFindsTheNearestFeatureAtAnyHeight) {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  const int n = 32;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      v.emplace_back(-4 + 8.0 * i / n, -4 + 8.0 * j / n, 0.2 * std::sin(0.9 * i) * std::cos(0.7 * j));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i;
+      t.push_back({a, a + 1, a + n + 2});
+      t.push_back({a, a + n + 2, a + n + 1});
+    }
+  const TerrainMesh mesh = makeTerrain(v, t);
+  const Support bumps{mesh, StaticMotion{}, "bumps"};
+  const Sphere ball{0.1, Vec3::Zero()};
+  const Ellipsoid egg{Vec3(0.1, 0.07, 0.05), Vec3::Zero(), axisAngle(Vec3(1, 1, 0).normalized(), 0.3)};
+  const auto on_ball = makeContact(ContactKind::Rolling, 0, ball, bumps);
+  const auto on_egg = makeContact(ContactKind::Rolling, 0, egg, bumps);
+  std::vector<std::shared_ptr<ShapeContact>> faces;
+  for (int f = 0; f < static_cast<int>(t.size()); ++f)
+    faces.push_back(makeContact(ContactKind::Rolling, 0, egg,
+                                Support{Plane{v[t[f][0]], terrainFaceNormal(mesh, f)},
+                                        StaticMotion{}, "face"}));
+  auto holds = [&](int f, const Vec3& p) {
+    const Vec3 &a = v[t[f][0]], &b = v[t[f][1]], &c = v[t[f][2]];
+    const Vec3 nf = terrainFaceNormal(mesh, f);
+    return nf.dot((b - a).cross(p - a)) >= -1e-12 && nf.dot((c - b).cross(p - b)) >= -1e-12 &&
+           nf.dot((a - c).cross(p - c)) >= -1e-12;
+  };
+  const auto body = makeCollisionGeometry(Shape{ball});
+  const auto terrain = makeCollisionGeometry(bumps);
+  std::srand(7);
+  auto uniform = [] { return std::rand() / double(RAND_MAX); };
+  int held = 0;
+  for (int k = 0; k < 400; ++k) {
+    const SE3 pose{Mat3::Identity(), Vec3(-3.5 + 7 * uniform(), -3.5 + 7 * uniform(),
+                                          0.35 + 2 * uniform())};
+    ContactGeometry g;
+    on_ball->geometry(pose, Vec6::Zero(), 0.0, g);
+    ASSERT_FALSE(g.singular) << "at " << pose.p.transpose();
+    const Proximity p = proximity(*body, pose, *terrain, SE3::Identity());
+    EXPECT_NEAR(g.gap, p.distance, 1e-9) << "at " << pose.p.transpose();
+    EXPECT_LT((g.support_point - p.support_point).norm(), 1e-6) << "at " << pose.p.transpose();
+    EXPECT_LT((g.point - p.body_point).norm(), 1e-6) << "at " << pose.p.transpose();
+
+    on_egg->geometry(pose, Vec6::Zero(), 0.0, g);
+    double brute = INFINITY;
+    for (int f = 0; f < static_cast<int>(faces.size()); ++f) {
+      ContactGeometry h;
+      faces[f]->geometry(pose, Vec6::Zero(), 0.0, h);
+      if (holds(f, h.support_point)) brute = std::min(brute, h.gap);
+    }
+    if (g.singular) {
+      EXPECT_EQ(brute, INFINITY) << "a holding face was missed at " << pose.p.transpose();
+      continue;
+    }
+    ++held;
+    EXPECT_NEAR(g.gap, brute, 1e-12) << "at " << pose.p.transpose();
+  }
+  EXPECT_GT(held, 150);
+}

@@ -134,8 +134,21 @@ Proximity proximity(const CollisionGeometry& body, const SE3& body_pose,
   fcl::DistanceResultd result;
   Proximity out;
   out.distance = fcl::distance(&a, &b, request, result);
-  out.body_point = result.nearest_points[0];
-  out.support_point = result.nearest_points[1];
+  const bool a_mesh = body.geometry->getObjectType() == fcl::OT_BVH;
+  const bool b_mesh = support.geometry->getObjectType() == fcl::OT_BVH;
+  if (a_mesh != b_mesh) {
+    // FCL 0.7 returns a shape–mesh pair's nearest points in the objects' own
+    // frames, the mesh's first, in either argument order (shape–shape and
+    // mesh–mesh pairs: world frame, argument order). Measured; see
+    // docs/contacts.md §9.
+    const Vec3& on_mesh = result.nearest_points[0];
+    const Vec3& on_shape = result.nearest_points[1];
+    out.body_point = a.getTransform() * (a_mesh ? on_mesh : on_shape);
+    out.support_point = b.getTransform() * (b_mesh ? on_mesh : on_shape);
+  } else {
+    out.body_point = result.nearest_points[0];
+    out.support_point = result.nearest_points[1];
+  }
   const Vec3 d = out.body_point - out.support_point;
   if (d.norm() > 0) out.normal = (out.distance < 0 ? -d : d).normalized();
   return out;

@@ -71,6 +71,10 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
     return;
   }
   const TerrainIndex& idx = *terrain.index;
+  if (const auto* sphere = std::get_if<Sphere>(&shape)) {
+    terrainSphereGeometry(*sphere, terrain, S, pose, V, out, opt);
+    return;
+  }
 
   // Box of the body in the support frame from its extreme points along the
   // support axes, grown by half its largest side: every face whose plane
@@ -130,11 +134,22 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
       out = trial;  // finite values to leave if no face holds the point
     }
   };
-  detail::forEachFaceInBox(idx, lo, hi, consider);
-  // A holding face farther than the margin (a body high above the terrain)
-  // lies outside the box: fall back to every face.
-  if (best < 0 || out.gap > margin) {
-    for (int f = 0; f < static_cast<int>(terrain.triangles.size()); ++f) consider(f);
+  // Widen the box until it must hold the best face: a face holding the
+  // contact with gap g meets the body's box grown by |g| (its foot is that
+  // far from a body point), so once a holding face with |gap| ≤ margin is
+  // known, no face outside the box can do better. Without a holding face
+  // the margin doubles until the box covers the whole terrain. A body high
+  // above the terrain (an open contact in flight) costs O(log n) queries,
+  // not a sweep over every face.
+  const auto& root = idx.bvh->getBV(0).bv.obb;
+  const Vec3 root_half = root.axis.cwiseAbs() * root.extent;
+  for (double m = margin;; m = best >= 0 ? std::abs(out.gap) * (1 + 1e-9) + 1e-12 : 2 * m) {
+    const Vec3 qlo = lo.array() - (m - margin), qhi = hi.array() + (m - margin);
+    detail::forEachFaceInBox(idx, qlo, qhi, consider);
+    if (best >= 0 && std::abs(out.gap) <= m) break;
+    const bool covers = ((qlo - (root.To - root_half)).array() <= 0).all() &&
+                        ((qhi - (root.To + root_half)).array() >= 0).all();
+    if (covers) break;
   }
   if (best >= 0) return;
   if (nearest < 0) {

@@ -69,5 +69,12 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
                      const SE3& pose, const Vec6& V, ContactGeometry& out,
                      const GeometryOptions& opt);
 
+/// A sphere on a terrain: the contact at the mesh point nearest to its
+/// centre — on a face (the plane contact), an edge or a vertex
+/// (terrain_sphere.cpp).
+void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, const SupportState& S,
+                           const SE3& pose, const Vec6& V, ContactGeometry& out,
+                           const GeometryOptions& opt);
+
 }  // namespace detail
 }  // namespace appell

@@ -1,0 +1,142 @@
+// A sphere on a terrain mesh: the contact is at the mesh point nearest to the
+// sphere's centre, on a face, an edge or a vertex — so a ball rolls across
+// the edges and vertices of the mesh, pivoting about them, instead of
+// stopping there (terrain.hpp states the face model).
+//
+// With c the centre, x the nearest mesh point and d = |c − x|:
+//   n = (c − x)/d,  gap = d − ρ,  contact point c − ρ n, support point x.
+// The normal's rate follows from c's velocity relative to the support,
+// u = V_B(c) − V_S(c), and the support's rotation Ω (e: the edge direction):
+//   face    ṅ = Ω × n                                (the plane contact, exactly)
+//   edge    ṅ = Ω × n + (1 − n nᵀ)(1 − e eᵀ) u / d   (x slides along the edge)
+//   vertex  ṅ = Ω × n + (1 − n nᵀ) u / d             (x stays put)
+// (differentiate n = P(c − a)/|P(c − a)| in the support frame, P = 1 − e eᵀ
+// on an edge, 1 on a vertex). The body-frame normal at the contact is
+// m = −Rᵀ n, so ṁ = −Rᵀ(ṅ − ω × n). Where the nearest feature changes (face
+// → edge → face) n is continuous and ṅ jumps: the curvature the ball rolls
+// on changes, as on any piecewise-flat surface.
+//
+// Nearest point on a triangle with its feature: Voronoi regions of the
+// vertices, edges and face (Ericson, Real-Time Collision Detection, 2005,
+// §5.1.5).
+#include "geometry_internal.hpp"
+#include "terrain_index.hpp"
+
+#include <cmath>
+
+namespace appell::detail {
+
+namespace {
+
+struct Nearest {
+  Vec3 x = Vec3::Zero();  ///< support frame
+  int face = -1;
+  int feature = -1;       ///< 0: face; 1 + k: edge opposite vertex k; 4 + k: vertex k
+};
+
+// Nearest point of triangle (a, b, c) to p, with the feature holding it.
+Nearest nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  Nearest r;
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return r.x = a, r.feature = 4, r;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return r.x = b, r.feature = 5, r;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return r.x = a + d1 / (d1 - d3) * ab, r.feature = 3, r;  // edge ab
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return r.x = c, r.feature = 6, r;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return r.x = a + d2 / (d2 - d6) * ac, r.feature = 2, r;  // edge ac
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)  // edge bc
+    return r.x = b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b), r.feature = 1, r;
+  const double denom = 1 / (va + vb + vc);
+  r.x = a + ab * (vb * denom) + ac * (vc * denom);
+  r.feature = 0;
+  return r;
+}
+
+}  // namespace
+
+void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, const SupportState& S,
+                           const SE3& pose, const Vec6& V, ContactGeometry& out,
+                           const GeometryOptions& opt) {
+  const TerrainIndex& idx = *terrain.index;
+  const Twist body(V), sup(S.V);
+  const Vec3 c = pose.apply(sphere.centre);
+  const Vec3 cs = S.pose.applyInv(c);  // support frame
+
+  // Candidate faces: every triangle within distance r of the centre meets the
+  // box cs ± r; r widens until the nearest point found lies within it.
+  Nearest best;
+  double best_d2 = INFINITY;
+  auto consider = [&](int f) {
+    const auto& tri = terrain.triangles[f];
+    Nearest n = nearestOnTriangle(cs, terrain.vertices[tri[0]], terrain.vertices[tri[1]],
+                                  terrain.vertices[tri[2]]);
+    const double d2 = (cs - n.x).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      n.face = f;
+      best = n;
+    }
+  };
+  const auto& root = idx.bvh->getBV(0).bv.obb;
+  const Vec3 root_half = root.axis.cwiseAbs() * root.extent;
+  for (double r = 2 * sphere.radius;; r = std::isfinite(best_d2) ? std::sqrt(best_d2) * (1 + 1e-9) + 1e-12 : 2 * r) {
+    const Vec3 lo = cs.array() - r, hi = cs.array() + r;
+    forEachFaceInBox(idx, lo, hi, consider);
+    if (best_d2 <= r * r) break;
+    if (((lo - (root.To - root_half)).array() <= 0).all() &&
+        ((hi - (root.To + root_half)).array() >= 0).all())
+      break;
+  }
+
+  const int f = best.face;
+  if (best.feature == 0) {
+    // Inside a face: the plane contact of that face, exactly.
+    Plane plane;
+    plane.point = terrain.vertices[terrain.triangles[f][0]];
+    plane.normal = idx.normal[f];
+    planeGeometry(sphere, plane, S, pose, V, out, opt);
+    return;
+  }
+  const Vec3 x = S.pose.apply(best.x);
+  const double d = (c - x).norm();
+  out = ContactGeometry{};
+  if (!(d > opt.singular_tol * sphere.radius)) {
+    out.point = c;
+    out.support_point = x;
+    out.gap = -sphere.radius;
+    markSingular(out, "the sphere's centre lies on a terrain edge or vertex: no unique normal");
+    return;
+  }
+  const Vec3 n = (c - x) / d;
+  const Vec3 u = body.at(c) - S.pointVelocity(c);
+  Vec3 e;  // tangent reference: the edge, or a support axis away from n
+  Vec3 ndot = sup.w.cross(n);
+  if (best.feature <= 3) {
+    const auto& tri = terrain.triangles[f];
+    const int k = best.feature - 1;
+    e = S.pose.R * (terrain.vertices[tri[(k + 2) % 3]] - terrain.vertices[tri[(k + 1) % 3]]).normalized();
+    const Vec3 pu = u - e * e.dot(u);
+    ndot += (pu - n * n.dot(pu)) / d;
+  } else {
+    e = S.pose.R.col(0);
+    if ((e - n * n.dot(e)).squaredNorm() < 0.5) e = S.pose.R.col(1);
+    ndot += (u - n * n.dot(u)) / d;
+  }
+  out.normal = n;
+  out.normal_rate = ndot;
+  out.gap = d - sphere.radius;
+  const Vec3 m = -(pose.R.transpose() * n);
+  const GaussPoint g = inverseGaussMap(sphere, m, opt.singular_tol);
+  const Vec3 mdot = -(pose.R.transpose() * (ndot - body.w.cross(n)));
+  finishPoint(pose, body, g, mdot, out);
+  tangentFrame(e, sup.w.cross(e), out);
+}
+
+}  // namespace appell::detail
