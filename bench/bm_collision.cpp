@@ -88,6 +88,18 @@ void BM_AnalyticSphereOnTerrain(benchmark::State& s) {
     benchmark::DoNotOptimize(g.gap);
   }
 }
+void BM_AnalyticEllipsoidOnTerrain(benchmark::State& s) {
+  // The face model (every shape but the sphere), 0.2 m above the terrain.
+  const auto contact = makeContact(
+      ContactKind::Rolling, 0, Ellipsoid{Vec3(0.1, 0.08, 0.06), Vec3::Zero(), Mat3::Identity()},
+      terrain());
+  ContactGeometry g;
+  const SE3 pose{Mat3::Identity(), Vec3(0.31, 0.22, 0.3)};
+  for (auto _ : s) {
+    contact->geometry(pose, kTwist, 0.0, g);
+    benchmark::DoNotOptimize(g.gap);
+  }
+}
 void BM_FclSphereOnTerrain(benchmark::State& s) {
   fcl(s, Sphere{0.1, Vec3::Zero()}, terrain(), SE3{Mat3::Identity(), Vec3(0.31, 0.22, 0.3)});
 }
@@ -102,6 +114,7 @@ BENCHMARK(BM_AnalyticDiskOnPlane);
 BENCHMARK(BM_FclDiskOnPlane);
 BENCHMARK(BM_FclBoxOnPlane);
 BENCHMARK(BM_AnalyticSphereOnTerrain);
+BENCHMARK(BM_AnalyticEllipsoidOnTerrain);
 BENCHMARK(BM_FclSphereOnTerrain);
 BENCHMARK(BM_FclBoxOnTerrain);
 

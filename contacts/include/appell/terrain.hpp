@@ -1,7 +1,11 @@
 // Terrain: a fixed (or rigidly moving) triangle mesh that bodies roll or slide
 // on, treated as a piecewise-planar surface.
 //
-// Contact model. For each candidate face f the shape is put against the plane
+// Contact model of a sphere: the nearest point of the mesh to its centre, on
+// a face, an edge or a vertex (terrain_sphere.cpp) — a ball pivots about the
+// edges it rolls over. Every other shape: the face model below.
+//
+// Face model. For each candidate face f the shape is put against the plane
 // of f exactly as on a Plane support (same Gauss-map point, rows and κ). The
 // face "holds" the contact when the foot of that contact point on the plane
 // lies inside the triangle (barycentric coordinates ≥ −1e-9). The shape
