@@ -136,7 +136,8 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
       << "wall time    " << r.wall_seconds << " s, "
       << 1e6 * r.wall_seconds / std::max<long>(1, c.steps) << " µs per step\n"
       << "energy       E0 = " << r.energy0 << " J, max |E "
-      << (r.events.empty() ? "" : "+ impact losses ") << "− E0| = " << r.max_energy_deviation
+      << (r.events.empty() ? "" : "+ impact losses ") << (r.friction_work > 0 ? "+ friction work " : "")
+      << "− E0| = " << r.max_energy_deviation
       << " J (" << r.relativeEnergyDeviation() << " relative)"
       << (r.passive ? "" : "  [driven scene: energy is not conserved]") << "\n"
       << "residuals    max |Av+b| = " << r.max_velocity_residual

@@ -260,3 +260,67 @@ TEST(ContactVertices, CylinderStandingOnItsFaceLandsOnItsRim) {
         << e.what();
   }
 }
+
+// Protects Coulomb friction on a non-smooth body and the work balance with
+// friction: a block on an incline of angle α on four sticking corners (μ)
+// stays put when tan α < μ; when tan α > μ all four corners slide together
+// and the block accelerates down the slope at g (sin α − μ cos α), the
+// friction taking μ m g cos α per metre — Simulator::frictionWork() to the
+// trapezoidal rule's accuracy, and E + friction work conserved. The four
+// normal rows are redundant (a block has 3 freedoms off the plane): the
+// sliding solve must still find the loads.
+TEST(ContactVertices, BlockOnAnInclineSticksOrSlidesByTheFrictionAngle) {
+  const double alpha = 0.4;  // tan α = 0.423
+  const Vec3 n(-std::sin(alpha), 0, std::cos(alpha));
+  const Vec3 down(-std::cos(alpha), 0, -std::sin(alpha));
+  for (double mu : {0.5, 0.3}) {
+    SCOPED_TRACE("mu = " + std::to_string(mu));
+    DroppedBox s = droppedBox(0, Mat3::Identity(), ContactKind::Rolling);
+    s.constraints.clear();
+    ContactSpec spec;
+    spec.kind = ContactKind::Rolling;
+    spec.body = 0;
+    spec.shape = Box{kHalf, SE3::Identity()};
+    spec.support = Support{Plane{Vec3::Zero(), n}, StaticMotion{}, "slope"};
+    spec.mu = mu;
+    spec.options.name = "block";
+    for (auto& c : makeVertexContacts(spec)) s.constraints.push_back(c);
+    const Mat3 R = axisAngle(Vec3::UnitY(), -alpha);
+    const Vec3 p0 = R * Vec3(0, 0, kHalf.z());
+    setFloatingPose(s.q0, 0, p0, R);
+    Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+    ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+    const double E0 = sim.energy();
+    double worst = 0, v_half = 0, t_half = -1;
+    while (sim.time() < 1.0 - 1e-12) {
+      const StepStatus st = sim.step(1e-2);
+      ASSERT_TRUE(st.ok) << st.message;
+      worst = std::max(worst, std::abs(sim.energy() + sim.frictionWork() + sim.impactEnergyLoss() - E0));
+      if (t_half < 0 && sim.time() >= 0.5) {
+        t_half = sim.time();
+        v_half = -sim.v()[3];
+      }
+    }
+    const double travelled = (sim.q().head<3>() - p0).dot(down);
+    int closed = 0;
+    for (int c = 0; c < 8; ++c) closed += sim.isClosed(c);
+    EXPECT_EQ(closed, 4) << "on its four lower corners";
+    if (mu > std::tan(alpha)) {
+      EXPECT_LT(sim.v().norm(), 1e-9) << "sticks";
+      EXPECT_LT(std::abs(travelled), 1e-9);
+      EXPECT_EQ(sim.frictionWork(), 0.0);
+    } else {
+      const double a = kG * (std::sin(alpha) - mu * std::cos(alpha));
+      EXPECT_NEAR((-sim.v()[3] - v_half) / (sim.time() - t_half), a, 1e-9)
+          << "slides at g (sin α − μ cos α)";
+      // Known defect (docs/contacts.md §8): just after the slip starts from
+      // rest the friction falls short, so the block runs 0.76 % further
+      // than ½ a t² by t = 1 s. Bounded here so that it cannot grow unseen.
+      EXPECT_NEAR(travelled, 0.5 * a, 0.01 * 0.5 * a);
+      EXPECT_NEAR(sim.frictionWork(), mu * kMass * kG * std::cos(alpha) * travelled, 1e-6)
+          << "friction takes μ m g cos α per metre";
+      EXPECT_LT(worst, 1e-6) << "E + friction work is conserved (trapezoidal rule)";
+    }
+  }
+}

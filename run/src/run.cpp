@@ -123,6 +123,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   double t_good = sim.time();
   VecX q_good = sim.q(), v_good = sim.v();
   const bool watch = s.passive && std::isfinite(options.max_energy_error);
+  bool restored = false;  // went back to the last good state (its loss counters restart)
   while (sim.time() < options.duration * (1 - 1e-12)) {
     const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
     if (!status.ok) {
@@ -130,7 +131,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       s.failure = status.message;
       break;
     }
-    const double deviation = std::abs(sim.energy() + sim.impactEnergyLoss() - s.energy0);
+    const double deviation =
+        std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - s.energy0);
     if (watch && !(deviation <= options.max_energy_error * s.energy_scale)) {
       // Diverging (an explicit method past its stability limit, a step too
       // long for a stiff moment): stop before the numbers blow up.
@@ -140,7 +142,11 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
           << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
       s.ok = false;
       s.failure = why.str();
-      sim.setState(t_good, q_good, v_good);
+      const double impacts = sim.impactEnergyLoss(), friction = sim.frictionWork();
+      sim.setState(t_good, q_good, v_good);  // (restarts the loss counters)
+      s.impact_energy_loss = impacts;
+      s.friction_work = friction;
+      restored = true;
       break;
     }
     if (watch) {
@@ -172,7 +178,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   // The last state reached is always sampled (the failure leaves the last good one).
   if (on_sample && !last_sampled) on_sample(sim);
   s.time = sim.time();
-  s.impact_energy_loss = sim.impactEnergyLoss();
+  if (!restored) {
+    s.impact_energy_loss = sim.impactEnergyLoss();
+    s.friction_work = sim.frictionWork();
+  }
   s.counters = sim.counters();
   s.partition_changes = sim.partitionChanges();
   return s;

@@ -124,6 +124,12 @@ class Simulator {
   /// round-off; an impact at setState() itself is not counted):
   /// E + impactEnergyLoss() is conserved by a passive scene.
   double impactEnergyLoss() const { return dissipated_; }
+  /// Energy taken by sliding friction since setState() (J, ≥ 0): the power
+  /// μ λₙ |slip| of each sliding contact, integrated over each step by the
+  /// trapezoidal rule from the step's end states (an O(h²) quadrature, not
+  /// round-off: E + impactEnergyLoss() + frictionWork() is conserved by a
+  /// passive scene to that accuracy).
+  double frictionWork() const { return friction_work_; }
   /// Whether unilateral constraint `c` is closed now.
   bool isClosed(int constraint) const { return cdata_->isActive(constraint); }
   const SimulatorCounters& counters() const { return counters_; }
@@ -179,6 +185,7 @@ class Simulator {
   std::vector<ContactEvent> events_;
   std::string state_error_;
   double dissipated_ = 0;
+  double friction_work_ = 0, friction_power_ = 0, power_t_ = 0;
 };
 
 }  // namespace appell

@@ -59,6 +59,9 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   events_.clear();
   state_error_.clear();
   dissipated_ = 0;
+  friction_work_ = 0;
+  friction_power_ = 0;
+  power_t_ = t_;
   if (uni_ && options_.contacts.enabled) {
     // A new state: unilateral constraints with clearance start open, the
     // touching ones get their modes decided (impact, then forces).
@@ -128,6 +131,18 @@ bool Simulator::evaluateEndState(std::string& error) {
   }
   kinetic_ = appell::kineticEnergy(model_, *data_, q_, v_);
   potential_ = appell::potentialEnergy(model_, *data_, q_);
+  // Work of sliding friction: its power μ λₙ |slip| per sliding contact,
+  // integrated over the step by the trapezoidal rule (O(h³) per step).
+  if (ok && options_.evaluate_end_state) {
+    double power = 0;
+    if (uni_)
+      for (const auto& r : uni_->rows)
+        if (cdata_->isActive(r.c) && cdata_->isSliding(r.c))
+          power += r.mu * std::max(0.0, result_.lambda[r.global]) * cdata_->slide[r.c].slip.norm();
+    if (t_ > power_t_) friction_work_ += 0.5 * (t_ - power_t_) * (friction_power_ + power);
+    friction_power_ = power;
+    power_t_ = t_;
+  }
   return ok;
 }
 

@@ -20,7 +20,8 @@
 //   events      every touchdown, bounce and lift-off (contact_events.hpp)
 //               with its time, speeds and impulses; an impulse outside the
 //               friction cone is flagged; the energy balance counts the
-//               kinetic energy the impacts took;
+//               kinetic energy the impacts took and the work of sliding
+//               friction;
 //   failure     the first step that fails stops the run; the summary keeps
 //               its reason and the time of the last good state.
 // The observer sees the state at t = 0, after every `output_every`-th step
@@ -55,8 +56,8 @@ struct RunOptions {
   /// clean stop: the state reached is sampled, the summary says so). For a
   /// SIGINT handler or another thread; null: never.
   const std::atomic<bool>* stop = nullptr;
-  /// Divergence watch (passive scenes, whose E + impact losses is
-  /// conserved): a step after which |E + losses − E₀| exceeds this fraction
+  /// Divergence watch (passive scenes, whose E + impact losses + friction
+  /// work is conserved): a step after which |E + losses − E₀| exceeds this fraction
   /// of the energy scale stops the run as failed, the state kept the last
   /// one within the bound. ∞ switches it off.
   double max_energy_error = 5e-2;
@@ -104,8 +105,9 @@ struct RunSummary {
   double wall_seconds = 0;         ///< wall time of the stepping loop
   bool passive = true;             ///< no joint forces, no moving support: E is conserved
   double energy0 = 0;              ///< E at t = 0 (J)
-  double max_energy_deviation = 0; ///< max |E + impact losses − E₀| (J)
+  double max_energy_deviation = 0; ///< max |E + impact losses + friction work − E₀| (J)
   double impact_energy_loss = 0;   ///< kinetic energy taken by impacts (J)
+  double friction_work = 0;        ///< energy taken by sliding friction (J, trapezoidal rule)
   std::vector<RunEvent> events;    ///< contact events, in time order
   double energy_scale = 0;         ///< max(|E₀|, T₀, 1e-12)
   double max_velocity_residual = 0;  ///< max ‖A v + b‖∞, t = 0 included
