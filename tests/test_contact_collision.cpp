@@ -154,9 +154,10 @@ TEST(ContactCollision, UnrepresentablePairsAreRefusedByName) {
 //  - a sphere's gap is FCL's exact sphere–mesh distance (FCL's own traversal
 //    of the hierarchy, sphere–triangle in closed form), its support point
 //    FCL's nearest point — on a face, an edge or a vertex (terrain_sphere.cpp);
-//  - an ellipsoid's gap is the brute-force one of the face model: every face
-//    tried as a plane, the smallest gap among faces whose triangle holds the
-//    foot of the contact point (singular where none does).
+//  - an ellipsoid's gap is FCL's GJK distance (to 1e-6, GJK's accuracy) —
+//    faces, edges and vertices all count — and never above the face model's
+//    brute-force gap (every face tried as a plane, the smallest gap among
+//    faces whose triangle holds the foot of the contact point).
 TEST(ContactCollision, TerrainSearchFindsTheNearestFeatureAtAnyHeight) {
   std::vector<Vec3> v;
   std::vector<std::array<int, 3>> t;
@@ -188,6 +189,7 @@ TEST(ContactCollision, TerrainSearchFindsTheNearestFeatureAtAnyHeight) {
            nf.dot((a - c).cross(p - c)) >= -1e-12;
   };
   const auto body = makeCollisionGeometry(Shape{ball});
+  const auto egg_fcl = makeCollisionGeometry(Shape{egg});
   const auto terrain = makeCollisionGeometry(bumps);
   std::srand(7);
   auto uniform = [] { return std::rand() / double(RAND_MAX); };
@@ -204,18 +206,18 @@ TEST(ContactCollision, TerrainSearchFindsTheNearestFeatureAtAnyHeight) {
     EXPECT_LT((g.point - p.body_point).norm(), 1e-6) << "at " << pose.p.transpose();
 
     on_egg->geometry(pose, Vec6::Zero(), 0.0, g);
-    double brute = INFINITY;
+    ASSERT_FALSE(g.singular) << "at " << pose.p.transpose();
+    double brute = INFINITY;  // the face model alone: an upper bound
     for (int f = 0; f < static_cast<int>(faces.size()); ++f) {
       ContactGeometry h;
       faces[f]->geometry(pose, Vec6::Zero(), 0.0, h);
       if (holds(f, h.support_point)) brute = std::min(brute, h.gap);
     }
-    if (g.singular) {
-      EXPECT_EQ(brute, INFINITY) << "a holding face was missed at " << pose.p.transpose();
-      continue;
-    }
-    ++held;
-    EXPECT_NEAR(g.gap, brute, 1e-12) << "at " << pose.p.transpose();
+    EXPECT_LE(g.gap, brute + 1e-12) << "at " << pose.p.transpose();
+    const double gjk = proximity(*egg_fcl, pose, *terrain, SE3::Identity()).distance;
+    EXPECT_NEAR(g.gap, gjk, 1e-6) << "at " << pose.p.transpose();
+    held += g.gap < brute - 1e-9;  // an edge or vertex nearer than every holding face
   }
-  EXPECT_GT(held, 150);
+  EXPECT_GT(held, 50) << "edges and vertices matter on this mesh";
+  std::printf("  %d of 400 ellipsoid contacts on an edge or vertex\n", held);
 }

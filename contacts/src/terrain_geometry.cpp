@@ -26,6 +26,9 @@ Vec3 barycentric(const TerrainMesh& t, const TerrainIndex& idx, int f, const Vec
 }
 
 constexpr double kInsideTol = 1e-9;
+/// Depth below which an edge or vertex contact is accepted (m): the drift the
+/// projection leaves is orders of magnitude smaller.
+constexpr double kFeatureDepth = 1e-6;
 
 // Reason text naming the edge or vertex; a per-thread buffer so that setting
 // it does not allocate (valid until this thread's next terrain query).
@@ -94,7 +97,7 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
   lo.array() -= margin;
   hi.array() += margin;
 
-  ContactGeometry trial;
+  ContactGeometry trial, feature;
   int best = -1, nearest = -1;
   double nearest_gap = INFINITY;  // the ranking score below
   Vec3 nearest_lambda = Vec3::Zero();
@@ -112,7 +115,34 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
         best = f;
         out = trial;
       }
-    } else if (best < 0) {
+      return;
+    }
+    // Not held by its face: the body may be nearest to one of its edges or
+    // vertices (over a crease or a corner). The face's plane gap bounds the
+    // triangle's distance from below, so only a triangle whose plane is
+    // nearer than the best contact so far is worth those solves. An edge or
+    // vertex is a distance, not a signed depth: one that the body has sunk
+    // past by more than drift (kFeatureDepth) says nothing about the contact.
+    auto better = [&](const ContactGeometry& g) {
+      return g.gap >= -kFeatureDepth && (best < 0 || g.gap < out.gap);
+    };
+    if (best < 0 || trial.gap < out.gap) {
+      const auto& tri = terrain.triangles[f];
+      for (int k = 0; k < 3; ++k) {
+        if (terrainEdgeGeometry(shape, terrain.vertices[tri[(k + 1) % 3]],
+                                terrain.vertices[tri[(k + 2) % 3]], S, pose, V, feature, opt) &&
+            better(feature)) {
+          best = f;
+          out = feature;
+        }
+        if (terrainVertexGeometry(shape, terrain.vertices[tri[k]], S, pose, V, feature, opt) &&
+            better(feature)) {
+          best = f;
+          out = feature;
+        }
+      }
+    }
+    if (best < 0) {
       // Rank the faces that do not hold the point by |gap| plus how far the
       // foot lies outside the triangle (max over edges of −λ_k times the
       // altitude onto edge k): the face the body is over names the edge.

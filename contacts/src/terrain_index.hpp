@@ -76,5 +76,16 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
                            const GeometryOptions& opt);
 
+/// A smooth shape against the terrain edge from a_s to b_s (support frame):
+/// false when the nearest point of the line lies beyond the segment, the
+/// solve does not converge, or the contact is singular (terrain_features.cpp).
+bool terrainEdgeGeometry(const Shape& shape, const Vec3& a_s, const Vec3& b_s,
+                         const SupportState& S, const SE3& pose, const Vec6& V,
+                         ContactGeometry& out, const GeometryOptions& opt);
+/// A smooth shape against the terrain vertex x_s: false when singular.
+bool terrainVertexGeometry(const Shape& shape, const Vec3& x_s, const SupportState& S,
+                           const SE3& pose, const Vec6& V, ContactGeometry& out,
+                           const GeometryOptions& opt);
+
 }  // namespace detail
 }  // namespace appell

@@ -155,6 +155,7 @@ class Simulator {
   double eventFunction(int u, detail::Crossing type);
   bool restepTo(double tau, StepStatus& st);
   bool decideModes(std::string& error);
+  bool featureSwitchImpact(std::string& error);
   bool projectAfterModes(std::string& error);
   bool impactPhase(std::string& error);
   bool forcePhase(std::string& error);

@@ -639,4 +639,40 @@ bool Simulator::decideModes(std::string& error) {
   return impactPhase(error) && forcePhase(error);
 }
 
+/// A closed contact whose nearest feature changed inside the step — a wheel
+/// rolling into a concave terrain crease meets the rising face — approaches
+/// its new feature at the step's end faster than rest_speed. That is an
+/// impact: resolved here, at the step's end (not yet located inside the step),
+/// by the same impact and force problems as a touchdown, its energy loss
+/// counted — instead of being absorbed unseen by the drift projection.
+bool Simulator::featureSwitchImpact(std::string& error) {
+  auto& u = *uni_;
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  forwardKinematics(model_, *data_, q_, v_);
+  bool approaching = false;
+  for (const auto& r : u.rows) {
+    if (r.joint || !cdata_->isActive(r.c)) continue;
+    const RowBlock& blk = cdata_->blocks[r.c];
+    double gamma = blk.b[r.row];
+    if (r.a >= 0) gamma += blk.Wa.row(r.row).dot(data_->oMi[r.a].act(data_->v[r.a]));
+    if (r.b >= 0) gamma -= blk.Wb.row(r.row).dot(data_->oMi[r.b].act(data_->v[r.b]));
+    approaching = approaching || gamma < -options_.contacts.rest_speed;
+  }
+  if (!approaching) return true;
+  if (options_.project_positions) {
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
+    if (!projection_.ok) {
+      error = "position projection failed: " + projection_.error;
+      return false;
+    }
+  }
+  forwardKinematics(model_, *data_, q_, v_);
+  const double T_before = appell::kineticEnergy(model_, *data_, q_, v_);
+  for (auto& r : u.rows) r.lifting = r.touching_down = false;
+  if (!decideModes(error) || !frictionPhase(error) || !projectAfterModes(error)) return false;
+  dissipated_ += T_before - appell::kineticEnergy(model_, *data_, q_, v_);
+  integrator_->reset();
+  return true;
+}
+
 }  // namespace appell

@@ -189,6 +189,11 @@ StepStatus Simulator::step(double h) {
   }
   if (!std::isfinite(t_) || !q_.allFinite() || !v_.allFinite())
     return fail(st, "the integrator produced a non-finite state");
+  if (uni_ && options_.contacts.enabled) {
+    std::string error;
+    if (!featureSwitchImpact(error))
+      return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+  }
 
   // Drift control: positions onto the gaps, then velocities onto A v + b = 0.
   if (options_.project_positions) {
