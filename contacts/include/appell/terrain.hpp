@@ -3,18 +3,21 @@
 //
 // Contact model of a sphere: the nearest point of the mesh to its centre, on
 // a face, an edge or a vertex (terrain_sphere.cpp) — a ball pivots about the
-// edges it rolls over. Every other shape: the face model below.
+// edges it rolls over. Every other shape: faces, then edges and vertices.
 //
-// Face model. For each candidate face f the shape is put against the plane
+// Faces. For each candidate face f the shape is put against the plane
 // of f exactly as on a Plane support (same Gauss-map point, rows and κ). The
 // face "holds" the contact when the foot of that contact point on the plane
 // lies inside the triangle (barycentric coordinates ≥ −1e-9). The shape
 // touches the holding face with the smallest signed gap. Inside a face the
 // contact is therefore exactly the plane contact: rolling on a face is exact.
-// When no face holds its contact point the body is over an edge or a vertex
-// of the mesh, where the surface has no tangent plane; the geometry is then
-// reported singular with a reason naming the edge (the two faces) or the
-// vertex, never an invented normal.
+// Edges and vertices. A triangle whose face does not hold the contact but
+// whose plane is nearer than the best contact so far offers its edges (the
+// shape's point nearest the edge's line, by Newton) and vertices (the
+// outside of a radius-0 sphere) — terrain_features.cpp; the smallest gap
+// wins. Only when none of these solves succeeds (a disk lying flat) is the
+// geometry singular, with a reason naming the edge or the vertex, never an
+// invented normal.
 //
 // Orientation. Each face's normal comes from its winding,
 //   n = (b − a) × (c − a) / |…|   for the triangle (a, b, c),
