@@ -26,9 +26,6 @@
 
 namespace appell::detail {
 
-namespace {
-
-// A body point to start from: the shape's centre (or pose origin).
 Vec3 shapeCentre(const Shape& shape) {
   return std::visit(
       [](const auto& s) -> Vec3 {
@@ -39,7 +36,21 @@ Vec3 shapeCentre(const Shape& shape) {
       shape);
 }
 
-}  // namespace
+double boundingRadius(const Shape& shape) {
+  return std::visit(
+      Overloaded{[](const PointShape&) { return 0.0; },
+                 [](const Sphere& s) { return s.radius; },
+                 [](const Ellipsoid& s) { return s.semi_axes.maxCoeff(); },
+                 [](const Disk& s) { return s.radius; },
+                 [](const Torus& s) { return s.major + s.minor; },
+                 [](const SphericalCap& s) { return s.radius; },
+                 [](const Box& s) { return double(s.half_extents.norm() + s.pose.p.norm()); },
+                 [](const Cylinder& s) {
+                   return std::hypot(s.radius, 0.5 * s.length) + s.pose.p.norm();
+                 },
+                 [](const Mesh&) { return double(INFINITY); }},
+      shape);
+}
 
 bool terrainEdgeGeometry(const Shape& shape, const Vec3& a_s, const Vec3& b_s,
                          const SupportState& S, const SE3& pose, const Vec6& V,

@@ -98,6 +98,10 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
   hi.array() += margin;
 
   ContactGeometry trial, feature;
+  bool features = false;
+  // The body's bounding sphere (support frame): centre and radius.
+  const Vec3 c_s = inv.apply(pose.apply(shapeCentre(shape)));
+  const double bound = boundingRadius(shape);
   int best = -1, nearest = -1;
   double nearest_gap = INFINITY;  // the ranking score below
   Vec3 nearest_lambda = Vec3::Zero();
@@ -117,6 +121,7 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
       }
       return;
     }
+    if (!features) return;
     // Not held by its face: the body may be nearest to one of its edges or
     // vertices (over a crease or a corner). The face's plane gap bounds the
     // triangle's distance from below, so only a triangle whose plane is
@@ -126,8 +131,15 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
     auto better = [&](const ContactGeometry& g) {
       return g.gap >= -kFeatureDepth && (best < 0 || g.gap < out.gap);
     };
-    if (best < 0 || trial.gap < out.gap) {
-      const auto& tri = terrain.triangles[f];
+    // A second, sharper lower bound: the distance from the body's bounding
+    // sphere to the triangle.
+    const auto& tri = terrain.triangles[f];
+    const double reach =
+        (c_s - nearestPointOnTriangle(c_s, terrain.vertices[tri[0]], terrain.vertices[tri[1]],
+                                      terrain.vertices[tri[2]]))
+            .norm() -
+        bound;
+    if (best < 0 || (trial.gap < out.gap && reach < out.gap)) {
       for (int k = 0; k < 3; ++k) {
         if (terrainEdgeGeometry(shape, terrain.vertices[tri[(k + 1) % 3]],
                                 terrain.vertices[tri[(k + 2) % 3]], S, pose, V, feature, opt) &&
@@ -146,7 +158,6 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
       // Rank the faces that do not hold the point by |gap| plus how far the
       // foot lies outside the triangle (max over edges of −λ_k times the
       // altitude onto edge k): the face the body is over names the edge.
-      const auto& tri = terrain.triangles[f];
       const double area2 = std::abs(
           idx.normal[f].dot((terrain.vertices[tri[1]] - terrain.vertices[tri[0]])
                                 .cross(terrain.vertices[tri[2]] - terrain.vertices[tri[0]])));
@@ -175,6 +186,11 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
   const Vec3 root_half = root.axis.cwiseAbs() * root.extent;
   for (double m = margin;; m = best >= 0 ? std::abs(out.gap) * (1 + 1e-9) + 1e-12 : 2 * m) {
     const Vec3 qlo = lo.array() - (m - margin), qhi = hi.array() + (m - margin);
+    // Faces first (cheap, and usually one holds), then the edges and
+    // vertices of the triangles that could still be nearer.
+    features = false;
+    detail::forEachFaceInBox(idx, qlo, qhi, consider);
+    features = true;
     detail::forEachFaceInBox(idx, qlo, qhi, consider);
     if (best >= 0 && std::abs(out.gap) <= m) break;
     const bool covers = ((qlo - (root.To - root_half)).array() <= 0).all() &&

@@ -76,6 +76,13 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
                            const GeometryOptions& opt);
 
+/// A point of the shape to measure from (its centre; a pose origin for the
+/// collision-only shapes) and the radius of a ball about it holding the shape.
+Vec3 shapeCentre(const Shape& shape);
+double boundingRadius(const Shape& shape);
+/// The point of triangle (a, b, c) nearest to p (terrain_sphere.cpp).
+Vec3 nearestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
 /// A smooth shape against the terrain edge from a_s to b_s (support frame):
 /// false when the nearest point of the line lies beyond the segment, the
 /// solve does not converge, or the contact is singular (terrain_features.cpp).

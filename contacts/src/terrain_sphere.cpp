@@ -61,6 +61,10 @@ Nearest nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec
 
 }  // namespace
 
+Vec3 nearestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return nearestOnTriangle(p, a, b, c).x;
+}
+
 void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
                            const GeometryOptions& opt) {
