@@ -455,9 +455,13 @@ TEST(ContactTerrain, EvaluationDoesNotAllocate) {
                   Support{flat, StaticMotion{}, "grid"});
   const auto on_ramp = makeContact(ContactKind::Rolling, 0, Sphere{0.1, Vec3::Zero()},
                                    Support{flatAndRamp(), StaticMotion{}, "ramp"});
-  RowBlock a, b;
+  const auto egg_on_ramp = makeContact(
+      ContactKind::Rolling, 0, Ellipsoid{Vec3(0.1, 0.08, 0.06), Vec3::Zero(), Mat3::Identity()},
+      Support{flatAndRamp(), StaticMotion{}, "ramp"});
+  RowBlock a, b, c;
   on_grid->reserve(model, a);
   on_ramp->reserve(model, b);
+  egg_on_ramp->reserve(model, c);
   Vec6 V;
   V << 0.3, -1, 0.2, 1, 0.5, 0;
   SE3 inside, edge, high;
@@ -470,8 +474,12 @@ TEST(ContactTerrain, EvaluationDoesNotAllocate) {
   on_grid->evaluateAt(high, V, 0.0, a);
   on_ramp->evaluateAt(edge, V, 0.0, b);
   on_ramp->evaluateAt(inside, V, 0.0, b);
+  SE3 egg_edge;
+  egg_edge.p = Vec3(0.01, 0.1, 0.07);  // an ellipsoid over the crease: the edge solve
+  egg_on_ramp->evaluateAt(egg_edge, V, 0.0, c);
   g_counting = false;
   EXPECT_EQ(g_news.load(), 0);
+  EXPECT_FALSE(c.singular) << c.singular_reason;
   EXPECT_FALSE(a.singular);
   EXPECT_NEAR(a.frame.gap, 4.9, 1e-12);
   on_ramp->evaluateAt(edge, V, 0.0, b);
