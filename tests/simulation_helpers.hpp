@@ -8,6 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace appell::test {
@@ -32,6 +35,50 @@ inline std::vector<ContactEvent> advanceCollecting(Simulator& sim, double t_end,
     all.insert(all.end(), sim.events().begin(), sim.events().end());
   }
   return all;
+}
+
+/// What a watched run records: its contact events, the largest
+/// |E + impact losses + friction work − E₀| at the ends of its steps, and a
+/// value read at the first lift-off (NaN when nothing lifted off).
+struct WatchedRun {
+  std::vector<ContactEvent> events;
+  double worst_energy = 0;
+  double at_lift_off = std::nan("");
+};
+
+/// Steps of h until t_end (every step must succeed), watching the energy
+/// balance; `at_lift_off(sim)` is read at the end of the step holding the
+/// first lift-off (the step ends at the event).
+template <class F>
+WatchedRun runWatching(Simulator& sim, double t_end, F&& at_lift_off, double h = 1e-2) {
+  WatchedRun run;
+  const double E0 = sim.energy();
+  while (sim.time() < t_end - 1e-12) {
+    const StepStatus st = sim.step(std::min(h, t_end - sim.time()));
+    EXPECT_TRUE(st.ok) << st.message;
+    if (!st.ok) break;
+    for (const ContactEvent& e : sim.events()) {
+      run.events.push_back(e);
+      if (e.kind == ContactEventKind::LiftOff && std::isnan(run.at_lift_off))
+        run.at_lift_off = at_lift_off(sim);
+    }
+    run.worst_energy = std::max(
+        run.worst_energy,
+        std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - E0));
+  }
+  return run;
+}
+
+/// The message of the std::invalid_argument that make() throws, or
+/// "(accepted)" when it throws none.
+template <class F>
+std::string invalidArgumentMessage(F&& make) {
+  try {
+    make();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(accepted)";
 }
 
 }  // namespace appell::test

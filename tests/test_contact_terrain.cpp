@@ -290,20 +290,11 @@ TEST(ContactTerrain, BallPivotsAboutTheCreaseAndLiftsOffWhereTheoryPredicts) {
     VecX q, v;
     ballState(Vec3(-0.2, 0.1, r), Vec3(v0, 0, 0), Vec3(0, v0 / r, 0), q, v);
     ASSERT_TRUE(sim.setState(0, q, v)) << sim.lastStateError();
-    const double E0 = sim.energy();
-    double worst = 0;
-    std::vector<ContactEvent> events;
-    double phi_lift = -1;
-    while (sim.time() < 1.0 - 1e-12) {
-      const StepStatus st = sim.step(1e-2);
-      ASSERT_TRUE(st.ok) << st.message;
-      for (const ContactEvent& e : sim.events()) {
-        events.push_back(e);
-        if (e.kind == ContactEventKind::LiftOff) phi_lift = std::atan2(sim.q()[0], sim.q()[2]);
-      }
-      worst = std::max(worst, std::abs(sim.energy() + sim.impactEnergyLoss() - E0));
-    }
-    EXPECT_LT(worst, 1e-8) << "E + impact losses is conserved";
+    const auto run = appell::test::runWatching(
+        sim, 1.0, [](const Simulator& s) { return std::atan2(s.q()[0], s.q()[2]); });
+    const auto& events = run.events;
+    const double phi_lift = run.at_lift_off;
+    EXPECT_LT(run.worst_energy, 1e-8) << "E + impact losses is conserved";
     const Vec3 ramp(std::sin(kSlope), 0, std::cos(kSlope));
     EXPECT_LT((sim.contactFrame(0).normal - ramp).norm(), 1e-9) << "on the ramp at the end";
     if (v0 > 0.9) {

@@ -61,18 +61,11 @@ TEST(ContactTerrainEdges, WheelRollsOffAPlatformAndLiftsOffWhereTheoryPredicts) 
                   IntegratorType::DormandPrince54, appell::test::tightIntegrator());
     ASSERT_TRUE(sim.setState(0, q, v)) << sim.lastStateError();
     ASSERT_TRUE(sim.isClosed(0));
-    const double E0 = sim.energy();
-    double worst = 0, phi_lift = -1;
-    std::vector<ContactEvent> events;
-    while (sim.time() < 1.0 - 1e-12) {
-      const StepStatus st = sim.step(1e-2);
-      ASSERT_TRUE(st.ok) << st.message;
-      for (const ContactEvent& e : sim.events()) {
-        events.push_back(e);
-        if (e.kind == ContactEventKind::LiftOff) phi_lift = std::atan2(sim.q()[0], sim.q()[2]);
-      }
-      worst = std::max(worst, std::abs(sim.energy() + sim.impactEnergyLoss() - E0));
-    }
+    const auto run = appell::test::runWatching(
+        sim, 1.0, [](const Simulator& s) { return std::atan2(s.q()[0], s.q()[2]); });
+    const auto& events = run.events;
+    const double phi_lift = run.at_lift_off;
+    const double worst = run.worst_energy;
     ASSERT_GE(events.size(), 2u);
     EXPECT_EQ(events[0].kind, ContactEventKind::LiftOff);
     const double phi_star = std::acos(((k + 1) * v0 * v0 / (kG * R) + 2) / (k + 3));

@@ -156,14 +156,7 @@ TEST(ContactVertices, CandidateVerticesOfEachShape) {
   Mesh flat = m;
   flat.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0.5, 0.5, 0}};
   flat.triangles = {{0, 1, 2}, {1, 3, 2}};
-  auto message = [](auto&& make) {
-    try {
-      make();
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("(accepted)");
-  };
+  auto message = [](auto&& make) { return appell::test::invalidArgumentMessage(make); };
   EXPECT_NE(message([&] { contactVertices(flat); }).find("mesh 'foot.stl': its vertices span no volume"),
             std::string::npos);
   EXPECT_NE(message([] { contactVertices(Sphere{0.1, Vec3::Zero()}); }).find("sphere:"),

@@ -47,14 +47,8 @@ fcl::Transform3d toFcl(const SE3& x) {
 }
 
 std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> meshModel(const Mesh& m) {
-  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-  std::vector<fcl::Triangle> tris;
-  tris.reserve(m.triangles.size());
-  for (const auto& t : m.triangles) tris.emplace_back(t[0], t[1], t[2]);
-  if (bvh->beginModel(static_cast<int>(tris.size()), static_cast<int>(m.vertices.size())) !=
-          fcl::BVH_OK ||
-      bvh->addSubModel(m.vertices, tris) != fcl::BVH_OK || bvh->endModel() != fcl::BVH_OK)
-    refuse("mesh '" + m.file + "'", "FCL could not build its hierarchy");
+  auto bvh = detail::buildHierarchy(m.vertices, m.triangles, false);
+  if (!bvh) refuse("mesh '" + m.file + "'", "FCL could not build its hierarchy");
   return bvh;
 }
 

@@ -24,23 +24,6 @@ Vec3 rawNormal(const TerrainMesh& t, int f) {
   return (t.vertices[tri[1]] - a).cross(t.vertices[tri[2]] - a);
 }
 
-// FCL's hierarchy over the triangles, split at the median along the axis of
-// greatest spread (depth ⌈log₂ n⌉ + 1; FCL's default mean split can be deep
-// on clustered meshes).
-std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> buildHierarchy(const TerrainMesh& t) {
-  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-  bvh->bv_splitter = std::make_shared<fcl::detail::BVSplitter<fcl::OBBRSSd>>(
-      fcl::detail::SPLIT_METHOD_MEDIAN);
-  std::vector<fcl::Triangle> tris;
-  tris.reserve(t.triangles.size());
-  for (const auto& tri : t.triangles) tris.emplace_back(tri[0], tri[1], tri[2]);
-  if (bvh->beginModel(static_cast<int>(tris.size()), static_cast<int>(t.vertices.size())) !=
-          fcl::BVH_OK ||
-      bvh->addSubModel(t.vertices, tris) != fcl::BVH_OK || bvh->endModel() != fcl::BVH_OK)
-    fail("FCL could not build its bounding-volume hierarchy");
-  return bvh;
-}
-
 // Longest root-to-leaf path, in nodes.
 int hierarchyDepth(const fcl::BVHModel<fcl::OBBRSSd>& bvh, int node) {
   const auto& n = bvh.getBV(node);
@@ -113,11 +96,34 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
       }
     }
   }
-  idx->bvh = buildHierarchy(t);
+  idx->bvh = detail::buildHierarchy(t.vertices, t.triangles, true);
+  if (!idx->bvh) fail("FCL could not build its bounding-volume hierarchy");
   idx->depth = hierarchyDepth(*idx->bvh, 0);
   if (idx->depth >= detail::kTerrainStack) fail("bounding-volume hierarchy too deep");
   t.index = std::move(idx);
   return t;
 }
 
+namespace detail {
+
+std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> buildHierarchy(
+    const std::vector<Vec3>& vertices, const std::vector<std::array<int, 3>>& triangles,
+    bool median) {
+  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
+  // The median split keeps the depth at ⌈log₂ n⌉ + 1 (FCL's default mean
+  // split can be deep on clustered meshes, and the query stack is fixed).
+  if (median)
+    bvh->bv_splitter = std::make_shared<fcl::detail::BVSplitter<fcl::OBBRSSd>>(
+        fcl::detail::SPLIT_METHOD_MEDIAN);
+  std::vector<fcl::Triangle> tris;
+  tris.reserve(triangles.size());
+  for (const auto& tri : triangles) tris.emplace_back(tri[0], tri[1], tri[2]);
+  if (bvh->beginModel(static_cast<int>(tris.size()), static_cast<int>(vertices.size())) !=
+          fcl::BVH_OK ||
+      bvh->addSubModel(vertices, tris) != fcl::BVH_OK || bvh->endModel() != fcl::BVH_OK)
+    return nullptr;
+  return bvh;
+}
+
+}  // namespace detail
 }  // namespace appell

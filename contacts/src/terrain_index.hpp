@@ -32,6 +32,13 @@ struct TerrainIndex {
 
 namespace detail {
 
+/// FCL's hierarchy over a triangle list (one triangle per leaf), split at the
+/// median when `median` (depth ⌈log₂ n⌉ + 1), else by FCL's default; null when
+/// FCL refuses the triangles.
+std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> buildHierarchy(
+    const std::vector<Vec3>& vertices, const std::vector<std::array<int, 3>>& triangles,
+    bool median);
+
 /// Depth the query stack must hold; makeTerrain refuses deeper trees (the
 /// median split never builds one below 2⁶³ faces).
 constexpr int kTerrainStack = 64;
