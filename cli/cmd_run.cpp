@@ -143,7 +143,14 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
       << "residuals    max |Av+b| = " << r.max_velocity_residual
       << ", max |gap| = " << r.max_gap_residual
       << (o.project_velocities ? "" : "  [projection off]") << "\n"
-      << "redundant    " << r.max_redundant << " rows\n";
+      << "redundant    " << r.max_redundant << " rows\n"
+      << "freedom      " << r.free_velocities << " independent velocities at t = 0";
+  if (r.free_velocities == 0 && scene.model.nv > 0)
+    out << "  ⚠ the constraints hold every body still: nothing can move (an over-constrained "
+           "vehicle — axles out of line by a CAD export's round-off make its no-slip rows "
+           "independent; give its wheels a friction coefficient 'mu' so they can scrub, or "
+           "align them)";
+  out << "\n";
   out << "events       ";
   int events = 0;
   if (r.partition_changes) {
@@ -228,6 +235,10 @@ int run(int argc, char** argv) {
   progress.done();
 
   printSummary(std::cout, scene, summary);
+  if (summary.free_velocities == 0 && scene.model.nv > 0)
+    std::cerr << "appell run: warning: " << scene.source
+              << ": the constraints leave 0 independent velocities — nothing in this scene can move "
+                 "(see 'freedom' in the summary)\n";
   if (summary.interrupted)
     std::cout << "interrupted  at t = " << summary.time << " s (SIGINT): the summary and the trajectory "
               << "end there\n";

@@ -172,3 +172,35 @@ TEST(Cli, DivergingIntegrationStopsAtTheEnergyBound) {
   const Result off = sh("run " + kDisk + " --integrator euler --dt 1e-2 --duration 0.5 --quiet --max-energy-error inf");
   EXPECT_EQ(off.output.find("diverging"), std::string::npos) << off.output;
 }
+
+// Protects the verdict on a vehicle that cannot move: the example car has one
+// free velocity (rolling straight ahead); with one rear wheel's axle turned
+// 1e-3 rad out of line its no-slip rows become independent, nothing can move,
+// and the run says so (summary line and a warning on stderr) instead of
+// quietly showing a car at rest.
+TEST(Cli, RunWarnsWhenTheConstraintsLeaveNoFreedom) {
+  const std::string car = std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf";
+  const Result good = sh("run " + car + " --duration 0.1 --quiet");
+  ASSERT_EQ(good.status, 0) << good.output;
+  EXPECT_NE(good.output.find("freedom      1 independent velocities at t = 0"), std::string::npos)
+      << good.output;
+  EXPECT_EQ(good.output.find("nothing can move"), std::string::npos) << good.output;
+
+  std::ifstream in(car);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string joint = "<joint name=\"rear_left_joint\" type=\"continuous\">";
+  const auto at = text.find(joint);
+  ASSERT_NE(at, std::string::npos);
+  const auto axis = text.find("<axis xyz=\"0 1 0\"/>", at);
+  ASSERT_NE(axis, std::string::npos);
+  text.replace(axis, 19, "<axis xyz=\"0.001 1 0\"/>");
+  const std::string bad = std::string(APPELL_BINARY_DIR) + "/cli_misaligned_car.urdf";
+  std::ofstream(bad) << text;
+  // Its initial speed violates the misaligned rows: projected (to rest).
+  const Result r = sh("run " + bad + " --duration 0.1 --quiet --project-initial");
+  EXPECT_NE(r.output.find("freedom      0 independent velocities at t = 0"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("warning: " + bad + ": the constraints leave 0 independent velocities"),
+            std::string::npos)
+      << r.output;
+}

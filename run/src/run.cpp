@@ -86,6 +86,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.max_velocity_residual = sim.velocityResidual();
   s.max_gap_residual = sim.gapResidual();
   s.max_redundant = sim.redundantRows();
+  s.free_velocities =
+      scene.model.nv - (sim.constraintData().m_active - sim.redundantRows());
   run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
   s.samples = 1;
   if (!sim.lastStateError().empty()) {

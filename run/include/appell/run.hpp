@@ -113,6 +113,10 @@ struct RunSummary {
   double max_velocity_residual = 0;  ///< max ‖A v + b‖∞, t = 0 included
   double max_gap_residual = 0;       ///< max |g|, t = 0 included
   int max_redundant = 0;           ///< most redundant rows at any sample
+  /// Independent velocities the closed constraints leave at t = 0:
+  /// nv − rank(A) (0: nothing can move — an over-constrained vehicle whose
+  /// axles are out of line, which the CLI warns about).
+  int free_velocities = 0;
   long samples = 0;                ///< states summarised (t = 0 and every step)
   std::vector<ContactStats> contacts;  ///< one per constraint, in order
 
