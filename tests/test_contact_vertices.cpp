@@ -3,6 +3,7 @@
 // unilateral point contacts.
 #include <gtest/gtest.h>
 
+#include <appell/run.hpp>
 #include <appell/simulator.hpp>
 #include <appell/urdf.hpp>
 #include <appell/vertex_contacts.hpp>
@@ -11,7 +12,10 @@
 #include "simulation_helpers.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 using namespace appell;
 using namespace appell::scenes;
@@ -316,4 +320,61 @@ TEST(ContactVertices, BlockOnAnInclineSticksOrSlidesByTheFrictionAngle) {
       EXPECT_LT(worst, 1e-6) << "E + friction work is conserved (trapezoidal rule)";
     }
   }
+}
+
+namespace {
+
+// A box (0.4 × 0.3 × 0.1 m) above a terrain mesh written next to the scene.
+Scene boxOverTerrain(const std::string& obj, const std::string& name, double x) {
+  const auto dir = std::filesystem::temp_directory_path() / "appell_vertex_watch";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / (name + ".obj")) << obj;
+  std::ostringstream urdf;
+  urdf << R"(<?xml version="1.0"?>
+<robot name="crate">
+  <link name="crate">
+    <inertial><mass value="3"/><inertia ixx="0.025" ixy="0" ixz="0" iyy="0.0425" iyz="0" izz="0.0625"/></inertial>
+    <collision><geometry><box size="0.4 0.3 0.1"/></geometry></collision>
+  </link>
+  <appell>
+    <support name="ground" type="terrain" filename=")"
+       << name << R"(.obj"/>
+    <contact name="corners" link="crate" kind="sliding" support="ground"/>
+    <initial><joint name="root_joint" xyz=")"
+       << x << R"( 0 0.1"/></initial>
+  </appell>
+</robot>)";
+  return loadSceneFromString(urdf.str(), dir.string());
+}
+
+}  // namespace
+
+// Protects the watch over what vertex contacts cannot see (run/src/
+// vertex_watch.cpp): a box dropped onto a roof's ridge lands on the ridge
+// with its bottom face, between its corners — FCL's distance between the
+// whole box and the mesh goes negative while every corner is still in the
+// air — and the run stops there naming the contact, the depth and the point,
+// instead of letting the box sink through the ridge. The same box dropped on
+// a flat mesh lands on its corners and the watch stays silent.
+TEST(ContactVertices, ARidgeBetweenTheCornersStopsTheRunByName) {
+  // A roof: ridge along y at x = 0, z = 0; slopes of 0.5 down to ±2 m.
+  const std::string roof = "v -2 -3 -1\nv 0 -3 0\nv 0 3 0\nv -2 3 -1\nv 2 -3 -1\nv 2 3 -1\n"
+                           "f 1 2 3\nf 1 3 4\nf 2 5 6\nf 2 6 3\n";
+  const std::string flat = "v -3 -3 -0.1\nv 3 -3 -0.1\nv 3 3 -0.1\nv -3 3 -0.1\nf 1 2 3\nf 1 3 4\n";
+  RunOptions o;
+  o.duration = 0.5;
+  o.integrator = IntegratorType::DormandPrince54;
+  o.tol = 1e-10;
+  o.dt = 1e-2;
+  const RunSummary ridge = runScene(boxOverTerrain(roof, "roof", 0.0), o);
+  EXPECT_FALSE(ridge.ok);
+  std::printf("  %s\n", ridge.failure.c_str());
+  EXPECT_NE(ridge.failure.find("contact 'corners' (a box on link 'crate'): the terrain presses "
+                               "into it by"),
+            std::string::npos)
+      << ridge.failure;
+  EXPECT_NEAR(ridge.time, std::sqrt(2 * 0.05 / kG), 0.02) << "where the ridge meets the face";
+  const RunSummary onto_flat = runScene(boxOverTerrain(flat, "flat", 0.0), o);
+  EXPECT_TRUE(onto_flat.ok) << onto_flat.failure;
+  EXPECT_EQ(onto_flat.events.size(), 4u) << "four corners land";
 }

@@ -149,20 +149,20 @@ Proximity proximity(const CollisionGeometry& body, const SE3& body_pose,
 }
 
 bool collide(const CollisionGeometry& body, const SE3& body_pose,
-             const CollisionGeometry& support, const SE3& support_pose, Vec3* point) {
+             const CollisionGeometry& support, const SE3& support_pose, Vec3* point,
+             double* depth) {
   const fcl::CollisionObjectd a(body.geometry, toFcl(body_pose * body.local));
   const fcl::CollisionObjectd b(support.geometry, toFcl(support_pose * support.local));
-  fcl::CollisionRequestd request(8, true);
+  fcl::CollisionRequestd request(64, true);
   fcl::CollisionResultd result;
   fcl::collide(&a, &b, request, result);
   if (!result.isCollision()) return false;
-  if (point) {
-    int deepest = 0;
-    for (int k = 1; k < static_cast<int>(result.numContacts()); ++k)
-      if (result.getContact(k).penetration_depth > result.getContact(deepest).penetration_depth)
-        deepest = k;
-    *point = result.getContact(deepest).pos;
-  }
+  int deepest = 0;
+  for (int k = 1; k < static_cast<int>(result.numContacts()); ++k)
+    if (result.getContact(k).penetration_depth > result.getContact(deepest).penetration_depth)
+      deepest = k;
+  if (point) *point = result.getContact(deepest).pos;
+  if (depth) *depth = result.getContact(deepest).penetration_depth;
   return true;
 }
 

@@ -1,5 +1,6 @@
 // The run loop and its summary (run.hpp).
 #include "contact_stats.hpp"
+#include "vertex_watch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -125,6 +126,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   double t_good = sim.time();
   VecX q_good = sim.q(), v_good = sim.v();
   const bool watch = s.passive && std::isfinite(options.max_energy_error);
+  run_detail::VertexWatch vertices(scene);  // boxes and meshes on terrain meshes
   bool restored = false;  // went back to the last good state (its loss counters restart)
   while (sim.time() < options.duration * (1 - 1e-12)) {
     const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
@@ -135,13 +137,20 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     }
     const double deviation =
         std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - s.energy0);
-    if (watch && !(deviation <= options.max_energy_error * s.energy_scale)) {
-      // Diverging (an explicit method past its stability limit, a step too
-      // long for a stiff moment): stop before the numbers blow up.
+    std::string uncovered;
+    const bool diverged = watch && !(deviation <= options.max_energy_error * s.energy_scale);
+    if (diverged || !vertices.check(sim, uncovered)) {
       std::ostringstream why;
-      why << "the energy error of this passive scene reached " << deviation / s.energy_scale
-          << " (relative) at t = " << sim.time() << " s, beyond the bound " << options.max_energy_error
-          << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
+      if (diverged) {
+        // Diverging (an explicit method past its stability limit, a step too
+        // long for a stiff moment): stop before the numbers blow up.
+        why << "the energy error of this passive scene reached " << deviation / s.energy_scale
+            << " (relative) at t = " << sim.time() << " s, beyond the bound "
+            << options.max_energy_error
+            << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
+      } else {
+        why << "at t = " << sim.time() << " s: " << uncovered;
+      }
       s.ok = false;
       s.failure = why.str();
       const double impacts = sim.impactEnergyLoss(), friction = sim.frictionWork();
@@ -151,7 +160,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       restored = true;
       break;
     }
-    if (watch) {
+    if (watch || vertices.active()) {
       t_good = sim.time();
       q_good = sim.q();
       v_good = sim.v();

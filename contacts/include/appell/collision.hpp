@@ -50,7 +50,8 @@ std::shared_ptr<const CollisionGeometry> makeCollisionGeometry(const Support& su
 
 /// Gap, witness points and normal of a pair (world frame).
 struct Proximity {
-  double distance = 0;       ///< > 0 apart; ≤ 0 touching or penetrating (then depth = −distance)
+  double distance = 0;       ///< > 0 apart; ≤ 0 touching or penetrating (depth = −distance for
+                             ///< shape pairs; a mesh pair gives −1: use collide() for its depth)
   Vec3 body_point = Vec3::Zero();     ///< nearest (deepest) point of the body's geometry
   Vec3 support_point = Vec3::Zero();  ///< nearest point of the support
   Vec3 normal = Vec3::UnitZ();        ///< unit, from the support toward the body
@@ -63,8 +64,12 @@ Proximity proximity(const CollisionGeometry& body, const SE3& body_pose,
                     const CollisionGeometry& support, const SE3& support_pose);
 
 /// True when the two geometries overlap (FCL's collide), with the deepest
-/// contact point in `point` (world) when given. Allocates.
+/// contact point in `point` (world) and its penetration depth in `depth`
+/// when given. Use this, not proximity(), for how deep a mesh pair
+/// overlaps: FCL's distance of an overlapping shape–mesh pair is −1, a flag,
+/// not a depth. Allocates.
 bool collide(const CollisionGeometry& body, const SE3& body_pose,
-             const CollisionGeometry& support, const SE3& support_pose, Vec3* point = nullptr);
+             const CollisionGeometry& support, const SE3& support_pose, Vec3* point = nullptr,
+             double* depth = nullptr);
 
 }  // namespace appell

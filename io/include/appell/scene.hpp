@@ -83,6 +83,16 @@ struct SimulationSettings {
   std::string formulation = "tree";  ///< a canonical name of formulationTable()
 };
 
+/// The vertex contacts one <contact> on a box, mesh or standing cylinder
+/// became (vertex_contacts.hpp): contacts[first, first + count).
+struct VertexGroup {
+  std::string name;   ///< the <contact>'s name
+  int body = -1;
+  Shape shape;        ///< the non-smooth shape, body frame
+  int support = -1;   ///< index into Scene::supports
+  int first = 0, count = 0;
+};
+
 struct Scene {
   Model model;
   /// One constraint per contact, in the order of `contacts`, then the joint
@@ -93,6 +103,7 @@ struct Scene {
   /// model.body_names[contact->bodyA()]).
   std::vector<std::shared_ptr<const ShapeContact>> contacts;
   std::vector<ContactOrigin> contact_origins;  ///< index-aligned with `contacts`
+  std::vector<VertexGroup> vertex_groups;      ///< contacts that are a shape's vertices
   /// URDF <limit lower upper> of revolute and prismatic joints, one per finite
   /// side (joint_limit.hpp; off with LoadOptions::joint_limits = false): the
   /// same objects as constraints[contacts.size() …].

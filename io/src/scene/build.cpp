@@ -169,6 +169,17 @@ void buildSceneContents(const XmlSource& src, const AppellBlock& block, const Lo
       fail(src, c.element, std::string(e.what()) + " (shape: " + shapeName(spec.shape) + " from " +
                                origin.shape_source + ")");
     }
+    if (!isSmoothContactShape(spec.shape)) {
+      VertexGroup g;
+      g.name = spec.options.name;
+      g.body = spec.body;
+      g.shape = spec.shape;
+      for (int k = 0; k < static_cast<int>(scene.supports.size()); ++k)
+        if (scene.supports[k].name == c.support) g.support = k;
+      g.first = static_cast<int>(scene.contacts.size());
+      g.count = static_cast<int>(made.size());
+      scene.vertex_groups.push_back(std::move(g));
+    }
     for (int k = 0; k < static_cast<int>(made.size()); ++k) {
       ContactOrigin o = origin;
       if (made.size() > 1) o.shape_source += ", vertex " + std::to_string(k);
