@@ -3,8 +3,7 @@
 
 #include <appell/appell.hpp>
 #include <appell/constrained_dynamics.hpp>
-
-#include <Eigen/QR>
+#include <appell/run.hpp>
 
 #include <cmath>
 #include <iomanip>
@@ -62,21 +61,22 @@ int info(int argc, char** argv) {
                 << l->bound() << ", restitution " << l->restitution() << "\n";
   }
   if (scene.constraintRows() > 0) {
-    Data data(m);
-    ConstraintData cd(m, scene.constraints);
-    evaluateConstraints(m, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
-    // Rank on equilibrated rows, with the solvers' default tolerance.
-    MatX A = cd.A;
-    for (int r = 0; r < A.rows(); ++r)
-      if (A.row(r).norm() > 0) A.row(r).normalize();
-    Eigen::ColPivHouseholderQR<MatX> qr(A);
-    qr.setThreshold(SolverOptions{}.rank_rel_tol);
-    const int rank = static_cast<int>(qr.rank());
-    std::cout << "at the initial state: rank " << rank << " of " << cd.m << " rows ("
-              << cd.m - rank << " redundant), " << m.nv - rank
-              << " independent velocities; residuals |Av+b| = " << velocityResidual(data, scene.constraints, cd, scene.v0)
-              << ", gap = " << gapResidual(cd) << "\n";
+    // The simulator's own start (tree solver, O(n)): which unilateral rows
+    // are closed, and the rank the solver decides with its tolerances on
+    // equilibrated rows — the numbers `appell run` then works with. No dense
+    // m × nv matrix: a 10⁵-link chain with joint limits has 2·10⁵ rows.
+    RunOptions options = runOptions(scene.settings);
+    options.formulation = Formulation::Tree;
+    const std::unique_ptr<Simulator> sim = makeSimulator(scene, options);
+    const ConstraintData& cd = sim->constraintData();
+    const int closed = cd.m_active, rank = closed - sim->redundantRows();
+    std::cout << "at the initial state: " << closed << " of " << cd.m << " rows closed, rank " << rank
+              << " (" << closed - rank << " redundant), " << m.nv - rank
+              << " independent velocities; residuals |Av+b| = " << sim->velocityResidual()
+              << ", gap = " << sim->gapResidual() << "\n";
     if (cd.singular) std::cout << "singular contact geometry: " << cd.singular_reason << "\n";
+    if (!sim->lastStateError().empty())
+      std::cout << "the initial state cannot start: " << sim->lastStateError() << "\n";
   }
   const SimulationSettings& s = scene.settings;
   std::cout << "\ndefaults: integrator " << s.integrator << ", dt " << s.dt << ", tol " << s.tol

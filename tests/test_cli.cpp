@@ -91,7 +91,7 @@ TEST(Cli, InfoReportsRowsAndRank) {
   const Result r = sh("info " + kDisk);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("nq = 7, nv = 6"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("rank 3 of 3 rows (0 redundant)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("3 of 3 rows closed, rank 3 (0 redundant)"), std::string::npos) << r.output;
 }
 
 TEST(Cli, RunConservesEnergyAndWritesTheTrajectory) {

@@ -19,7 +19,7 @@ VertexWatch::VertexWatch(const Scene& scene) : scene_(scene) {
     w.terrain_pose = supportState(support.motion, 0.0).pose;
     groups_.push_back(std::move(w));
   }
-  if (!groups_.empty()) data_ = std::make_unique<Data>(scene.model);
+  if (!groups_.empty()) data_ = std::make_unique<Data>(scene.model, MassMatrix::None);
 }
 
 bool VertexWatch::check(const Simulator& sim, std::string& why) {

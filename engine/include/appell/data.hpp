@@ -8,8 +8,15 @@
 
 namespace appell {
 
+/// Whether a Data holds the dense nv × nv mass matrix (crba's output). The
+/// O(n) algorithms (aba, rnea, the tree solver) never read it; a Data without
+/// it costs O(n) memory, so a 10⁵-body model fits.
+enum class MassMatrix { Sized, None };
+
 struct Data {
-  explicit Data(const Model& model);
+  /// Sizes every buffer once; M (nv × nv) only with MassMatrix::Sized — a
+  /// crba() on a Data without it sizes M on that first call.
+  explicit Data(const Model& model, MassMatrix mass = MassMatrix::Sized);
 
   // Kinematics (forwardKinematics).
   std::vector<SE3> liMi;   ///< body i in its parent
@@ -21,7 +28,7 @@ struct Data {
   std::vector<Vec6> f;     ///< RNEA: force transmitted by joint i, body frame
   VecX tau;                ///< RNEA output
   VecX nle;                ///< h(q, v) = C v + g (nonLinearEffects)
-  MatX M;                  ///< CRBA output (full symmetric)
+  MatX M;                  ///< CRBA output (full symmetric); empty with MassMatrix::None
   VecX ddq;                ///< ABA output
   std::vector<Mat6> Ic;    ///< CRBA composite inertias
 

@@ -6,6 +6,7 @@ namespace appell {
 
 const MatX& crba(const Model& model, Data& data, const VecX& q) {
   forwardKinematics(model, data, q);
+  if (data.M.rows() != model.nv) data.M.setZero(model.nv, model.nv);  // a Data built with MassMatrix::None
   for (int i = 0; i < model.nbodies; ++i) data.Ic[i] = model.spatial_inertia[i];
   for (int i = model.nbodies - 1; i >= 0; --i) {
     const int p = model.parent[i];

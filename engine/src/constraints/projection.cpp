@@ -13,8 +13,8 @@ namespace appell {
 
 struct PositionProjector::Impl {
   Impl(const Model& model, const ConstraintList& constraints, const ProjectionOptions& o)
-      : opt(o), mh(countHolonomic(constraints)), llt(model.nv), basis(model.nv, mh),
-        Ah(MatX::Zero(mh, model.nv)), B(MatX::Zero(model.nv, mh)), J(MatX::Zero(6, model.nv)),
+      : opt(o), mh(countHolonomic(constraints)), nd(mh > 0 ? model.nv : 0), llt(nd),
+        basis(nd, mh), Ah(MatX::Zero(mh, nd)), B(MatX::Zero(nd, mh)), J(MatX::Zero(6, nd)),
         g(VecX::Zero(mh)),
         y(VecX::Zero(model.nv)), theta(VecX::Zero(model.nv)), v0(VecX::Zero(model.nv)),
         q_start(VecX::Zero(model.nq)), q_next(VecX::Zero(model.nq)) {
@@ -35,7 +35,7 @@ struct PositionProjector::Impl {
     }
     for (int i = 0; i < static_cast<int>(holonomic_flags.size()); ++i)
       if (holonomic_flags[i]) row_map.push_back(i);
-    Ak = MatX::Zero(rows_max, model.nv);
+    Ak = MatX::Zero(rows_max, nd);
     abias_k = VecX::Zero(rows_max);
   }
 
@@ -70,6 +70,8 @@ struct PositionProjector::Impl {
 
   ProjectionOptions opt;
   int mh;
+  int nd;  // columns of the dense storage: nv, or 0 when there is nothing to project
+           // (no nv × nv mass matrix for a model without holonomic rows)
   Eigen::LLT<MatX> llt;
   detail::RowBasis basis;
   MatX Ah, B, J, Ak;

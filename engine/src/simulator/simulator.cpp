@@ -18,7 +18,8 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   if (!solver_) throw std::invalid_argument("Simulator: no constrained solver given");
   for (const auto& c : constraints_)
     if (!c) throw std::invalid_argument("Simulator: the constraint list holds a null constraint");
-  data_ = std::make_unique<Data>(model_);
+  data_ = std::make_unique<Data>(
+      model_, solver_->usesDenseRows() ? MassMatrix::Sized : MassMatrix::None);
   // Dense storage (m × nv) only for the formulations that assemble A.
   cdata_ = std::make_unique<ConstraintData>(
       model_, constraints_, solver_->usesDenseRows() ? DenseRows::Sized : DenseRows::None);

@@ -1,0 +1,100 @@
+// Models of 10⁵ bodies: loading, a simulator and a step cost O(n) memory
+// (no nv × nv mass matrix, no m × nv rows on the tree path, no stored paths),
+// and the step is right: a chain falling freely from rest keeps its shape.
+//
+// Memory is read from glibc's allocator (mallinfo2: bytes in use), so the
+// test asserts the growth from 10⁴ to 10⁵ links — linear, not quadratic —
+// rather than any time (speed belongs to the benchmarks).
+#include <appell/appell.hpp>
+#include <appell/run.hpp>
+#include <appell/urdf.hpp>
+
+#include <gtest/gtest.h>
+
+#include <malloc.h>
+
+#include <sstream>
+
+using namespace appell;
+
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
+/// A chain of n links on continuous joints about y, each hanging 0.1 m
+/// below its parent; the first link's joint to the world is floating.
+std::string chainUrdf(int n) {
+  std::ostringstream u;
+  u << "<robot name=\"chain\">\n";
+  const char* inertial =
+      "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" "
+      "ixz=\"0\" iyz=\"0\"/></inertial>";
+  for (int i = 0; i <= n; ++i) u << "<link name=\"l" << i << "\">" << inertial << "</link>\n";
+  for (int i = 0; i < n; ++i)
+    u << "<joint name=\"j" << i << "\" type=\"continuous\"><parent link=\"l" << i
+      << "\"/><child link=\"l" << i + 1 << "\"/><origin xyz=\"0 0 -0.1\"/><axis xyz=\"0 1 0\"/></joint>\n";
+  u << "</robot>\n";
+  return u.str();
+}
+
+std::size_t bytesInUse() {
+  const struct mallinfo2 mi = mallinfo2();
+  return mi.uordblks + mi.hblkhd;
+}
+
+struct Measured {
+  std::size_t bytes = 0;  ///< held by the scene and the simulator after one step
+  double max_joint_rate = 0, root_speed_error = 0;
+};
+
+Measured loadAndStep(int n) {
+  Measured out;
+  const std::string xml = chainUrdf(n);
+  const std::size_t before = bytesInUse();
+  {
+    const Scene scene = loadSceneFromString(xml, ".");
+    EXPECT_EQ(scene.model.nbodies, n + 1);
+    RunOptions options = runOptions(scene.settings);
+    options.formulation = Formulation::Tree;
+    options.integrator = IntegratorType::RK4;
+    const auto sim = makeSimulator(scene, options);
+    const double h = 1e-3;
+    const StepStatus st = sim->step(h);
+    EXPECT_TRUE(st.ok) << st.message;
+    out.bytes = bytesInUse() - before;
+    // Free fall from rest in a uniform field: no relative motion, and the
+    // floating root's linear velocity (body frame = world frame here) is g h.
+    const Model& m = scene.model;
+    const VecX& v = sim->v();
+    out.max_joint_rate = v.tail(m.nv - 6).lpNorm<Eigen::Infinity>();
+    out.root_speed_error = (v.segment<3>(3) - m.gravity * h).norm();
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(LargeModels, ChainOf100000LinksLoadsAndStepsInLinearMemory) {
+  if (kSanitized) GTEST_SKIP() << "mallinfo2 does not see a sanitizer's allocator";
+  const Measured small = loadAndStep(10000), large = loadAndStep(100000);
+  for (const Measured* r : {&small, &large}) {
+    EXPECT_LT(r->max_joint_rate, 1e-9);
+    EXPECT_LT(r->root_speed_error, 1e-12);
+  }
+  ASSERT_GT(small.bytes, 0u);
+  const double growth = static_cast<double>(large.bytes) / static_cast<double>(small.bytes);
+  // 10× the links: ~10× the memory (a dense nv × nv matrix would be 100×).
+  RecordProperty("bytes_per_body", static_cast<int>(large.bytes / 100000));
+  EXPECT_LT(growth, 12.0) << small.bytes << " → " << large.bytes << " bytes";
+  EXPECT_LT(large.bytes / 100000.0, 64.0 * 1024) << "bytes per body";
+}
