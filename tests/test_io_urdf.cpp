@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <unistd.h>
 #include <filesystem>
+#include <fstream>
 
 using namespace appell;
 
@@ -212,4 +214,61 @@ TEST(IoMesh, UrdfMeshGeometryIsResolvedAndScaled) {
   const Scene light = loadScene(kData + "meshes.urdf", opt);
   EXPECT_FALSE(light.geometry[0].visual[0].mesh);
   EXPECT_TRUE(std::filesystem::is_regular_file(light.geometry[0].visual[0].mesh_path));
+}
+
+// ROS 2 installs a package under <prefix>/share/<package>; AMENT_PREFIX_PATH
+// lists the prefixes.
+TEST(IoMesh, PackageUrisThroughAmentPrefixPath) {
+  namespace fs = std::filesystem;
+  const fs::path prefix = fs::temp_directory_path() / ("appell_ament_" + std::to_string(::getpid()));
+  fs::remove_all(prefix);
+  fs::create_directories(prefix / "share" / "demo_description" / "meshes");
+  fs::copy_file(kData + "meshes/tetra.stl", prefix / "share/demo_description/meshes/tetra.stl");
+  LoadOptions opt;
+  ::setenv("AMENT_PREFIX_PATH", ("/nonexistent/prefix:" + prefix.string()).c_str(), 1);
+  ::unsetenv("ROS_PACKAGE_PATH");
+  EXPECT_EQ(findPackage("demo_description", opt), (prefix / "share/demo_description").string());
+  const std::string p = resolveMeshPath("package://demo_description/meshes/tetra.stl", "/", opt);
+  EXPECT_EQ(p, (prefix / "share/demo_description/meshes/tetra.stl").string());
+  try {
+    resolveMeshPath("package://absent_description/meshes/tetra.stl", "/", opt);
+    ADD_FAILURE() << "an absent package was found";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("AMENT_PREFIX_PATH prefixes [/nonexistent/prefix:" + prefix.string()),
+              std::string::npos) << e.what();
+  }
+  ::unsetenv("AMENT_PREFIX_PATH");
+  fs::remove_all(prefix);
+}
+
+// A symbolic link back up the tree is a cycle: without care a bounded-depth
+// walk revisits the loop's folders exponentially often. Each folder is
+// entered once, so the search for a missing package ends, and a package
+// reachable through a link is still found.
+TEST(IoMesh, PackageSearchSurvivesSymlinkCycles) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / ("appell_cycle_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  // 24 folders a0 … a23, each linking to every other: a walk that does not
+  // remember where it has been visits 23⁶ ≈ 1.5·10⁸ folders (beyond the
+  // test's time limit); this one visits 25.
+  const int n = 24;
+  for (int i = 0; i < n; ++i) fs::create_directories(root / ("a" + std::to_string(i)));
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (i != j)
+        fs::create_directory_symlink(root / ("a" + std::to_string(j)),
+                                     root / ("a" + std::to_string(i)) / ("to" + std::to_string(j)));
+  fs::create_directories(root / "a7" / "pkg_dir");
+  {
+    std::ofstream(root / "a7/pkg_dir/package.xml") << "<package><name>linked_pkg</name></package>\n";
+  }
+  LoadOptions opt;
+  opt.use_ros_package_path = false;
+  opt.package_paths = {(root / "a0").string()};
+  EXPECT_EQ(findPackage("absent_pkg", opt), "");
+  const std::string found = findPackage("linked_pkg", opt);
+  ASSERT_FALSE(found.empty());
+  EXPECT_TRUE(fs::equivalent(found, root / "a7/pkg_dir")) << found;
+  fs::remove_all(root);
 }

@@ -27,8 +27,10 @@ namespace appell {
 struct LoadOptions {
   /// Folders searched for `package://NAME/…`, before ROS_PACKAGE_PATH.
   std::vector<std::string> package_paths;
-  /// Also search the colon-separated folders of the environment variable
-  /// ROS_PACKAGE_PATH (after `package_paths`).
+  /// Also search the environment (after `package_paths`): ROS 1's
+  /// ROS_PACKAGE_PATH (colon-separated folders holding packages, searched for
+  /// a folder named as the package or a package.xml naming it) and ROS 2's
+  /// AMENT_PREFIX_PATH (colon-separated install prefixes: <prefix>/share/<package>).
   bool use_ros_package_path = true;
   /// Read mesh files (visual and collision). When false, mesh geometry keeps
   /// its resolved path but no triangles, and a missing file is still an error.
@@ -65,8 +67,10 @@ std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
                             const LoadOptions& options = {});
 
 /// Folder of package NAME: the first search-path entry E with E/NAME a folder,
-/// or a folder under E (E itself included, searched depth-first up to 6
-/// levels) holding a package.xml whose <name> is NAME. Empty if none.
+/// else the first AMENT_PREFIX_PATH prefix P with P/share/NAME a folder, else
+/// a folder under a search-path entry (E itself included, breadth-first up to
+/// 6 levels, following symbolic links but entering each folder once, at most
+/// 10⁵ folders in all) holding a package.xml whose <name> is NAME. Empty if none.
 std::string findPackage(const std::string& name, const LoadOptions& options = {});
 
 /// Reads a triangle mesh (STL, OBJ, Collada/DAE and the other formats assimp
