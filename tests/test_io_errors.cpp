@@ -247,3 +247,41 @@ TEST(IoErrors, MeshFaceIndexBeyondTheVerticesAndHugeAxes) {
   EXPECT_TRUE(s.model.joints[0].axis.isApprox(Vec3(1, 1, 0).normalized())) << s.model.joints[0].axis.transpose();
   std::filesystem::remove_all(dir);
 }
+
+// A .urdf.xacro given as it is gets one error, at the first xacro construct,
+// saying to run xacro — not a cascade of "not a number" and unknown elements.
+TEST(IoErrors, UnexpandedXacroIsNamedOnce) {
+  auto message = [](const std::string& xml) {
+    try {
+      loadSceneFromString(xml, ".", "robot.urdf.xacro");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  const std::string link =
+      "<link name=\"a\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" "
+      "iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n";
+  const std::string substitution = "<robot name=\"r\">\n" + link +
+                                   "<link name=\"b\"><inertial><mass value=\"${wheel_mass}\"/>"
+                                   "</inertial></link>\n</robot>\n";
+  const std::string m1 = message(substitution);
+  EXPECT_NE(m1.find("robot.urdf.xacro:3:"), std::string::npos) << m1;
+  EXPECT_NE(m1.find("value=\"${wheel_mass}\""), std::string::npos) << m1;
+  EXPECT_NE(m1.find("unexpanded xacro"), std::string::npos) << m1;
+  EXPECT_NE(m1.find("xacro FILE.urdf.xacro > FILE.urdf"), std::string::npos) << m1;
+
+  const std::string macro = "<robot name=\"r\">\n" + link +
+                            "<xacro:property name=\"r\" value=\"0.1\"/>\n"
+                            "<mesh filename=\"$(find pkg)/a.stl\"/>\n</robot>\n";
+  const std::string m2 = message(macro);
+  EXPECT_NE(m2.find("robot.urdf.xacro:3: <xacro:property"), std::string::npos) << m2;
+  EXPECT_NE(m2.find("element <xacro:property>"), std::string::npos) << m2;
+
+  const std::string declared =
+      "<robot name=\"r\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n" + link + "</robot>\n";
+  EXPECT_NE(message(declared).find("xmlns:xacro declared"), std::string::npos) << message(declared);
+  // A plain URDF with a '$' in a name is not xacro.
+  EXPECT_EQ(message("<robot name=\"r\">\n" + link + "<link name=\"cost$1\"/></robot>").find("unexpanded"),
+            std::string::npos);
+}

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <set>
+#include <vector>
 #include <sstream>
 
 namespace appell::io {
@@ -62,6 +63,33 @@ static int nestingDepth(const std::string& xml, int limit) {
   return deepest;
 }
 
+namespace {
+
+// A .urdf.xacro given as it is: xacro elements (<xacro:macro>, …) or
+// substitutions (${…}, $(find …)) left in. One error, at the first one, says
+// what to do, instead of a cascade of "is not a number" and unknown elements.
+void rejectXacro(const XmlSource& src, const TiXmlElement* robot) {
+  const std::string how =
+      ": the file still holds unexpanded xacro — expand it first: xacro FILE.urdf.xacro > FILE.urdf";
+  std::vector<const TiXmlElement*> pending{robot};  // the depth is bounded above; no recursion anyway
+  while (!pending.empty()) {
+    const TiXmlElement* e = pending.back();
+    pending.pop_back();
+    const std::string tag = e->Value();
+    if (tag.rfind("xacro:", 0) == 0) fail(src, e, "element <" + tag + ">" + how);
+    for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+      const std::string name = a->Name(), value = a->Value();
+      if (name == "xmlns:xacro") fail(src, e, "xmlns:xacro declared" + how);
+      if (value.find("${") != std::string::npos || value.find("$(") != std::string::npos)
+        fail(src, e, std::string("attribute ") + a->Name() + "=\"" + clipped(value) + "\"" + how);
+    }
+    for (const TiXmlNode* c = e->LastChild(); c; c = c->PreviousSibling())  // document order
+      if (const TiXmlElement* ce = c->ToElement()) pending.push_back(ce);
+  }
+}
+
+}  // namespace
+
 const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
                                   const std::string& xml) {
   constexpr int kMaxDepth = 256;  // a URDF is 3–4 levels deep
@@ -83,6 +111,7 @@ const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
   if (!robot) fail(src, "malformed XML: no root element");
   if (std::string(robot->Value()) != "robot")
     fail(src, robot, "the root element must be <robot>");
+  rejectXacro(src, robot);
   return robot;
 }
 
