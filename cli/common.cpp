@@ -3,6 +3,7 @@
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
 
+#include <iostream>
 #include <sstream>
 
 namespace appell::cli {
@@ -15,7 +16,9 @@ Scene loadFromArgs(const Args& args, bool check_initial) {
   opt.check_initial_state = check_initial;
   opt.project_initial_state = args.has("project-initial");
   opt.joint_limits = !args.has("no-joint-limits");
-  return loadScene(args.positional()[0], opt);
+  Scene scene = loadScene(args.positional()[0], opt);
+  for (const std::string& w : scene.warnings) std::cerr << "appell: warning: " << w << "\n";
+  return scene;
 }
 
 std::string helpText(const char* text) {

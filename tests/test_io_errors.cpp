@@ -75,6 +75,30 @@ TEST(IoErrors, MissingMeshFile) {
   expectError("missing_mesh.urdf", 6, {"<mesh>", "meshes/does_not_exist.stl", "file not found"});
 }
 
+// A visual mesh only draws the link: when it is missing the scene loads,
+// without it, and says so (file, line, element, path) in Scene::warnings.
+TEST(IoErrors, MissingVisualMeshIsAWarning) {
+  const std::string urdf = R"(<?xml version="1.0"?>
+<robot name="r">
+  <link name="body">
+    <inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <visual><geometry><mesh filename="package://absent_pkg/meshes/body.dae"/></geometry></visual>
+    <visual><geometry><box size="1 1 1"/></geometry></visual>
+  </link>
+</robot>)";
+  LoadOptions opt;
+  opt.use_ros_package_path = false;
+  const Scene s = loadSceneFromString(urdf, ".", "visual.urdf", opt);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  const std::string& w = s.warnings[0];
+  for (const char* part : {"visual.urdf:5:", "<mesh>", "package 'absent_pkg' not found", "visual only"})
+    EXPECT_NE(w.find(part), std::string::npos) << part << " in " << w;
+  ASSERT_EQ(s.geometry.size(), 1u);
+  ASSERT_EQ(s.geometry[0].visual.size(), 1u);  // the box is kept
+  EXPECT_EQ(s.geometry[0].visual[0].type, GeometryType::Box);
+  EXPECT_DOUBLE_EQ(s.model.totalMass(), 1.0);
+}
+
 TEST(IoErrors, MeshWithNoTriangles) {
   expectError("empty_mesh.urdf", 6, {"<mesh>", "lines_only.obj", "no triangles"});
 }
@@ -230,7 +254,7 @@ TEST(IoErrors, MeshFaceIndexBeyondTheVerticesAndHugeAxes) {
   const std::string urdf = R"(<?xml version="1.0"?>
 <robot name="r"><link name="world"/>
   <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
-    <visual><geometry><mesh filename="bad.ply"/></geometry></visual></link>
+    <collision><geometry><mesh filename="bad.ply"/></geometry></collision></link>
   <joint name="j" type="revolute"><parent link="world"/><child link="a"/><axis xyz="1e308 1e308 0"/>
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
 </robot>)";
@@ -242,7 +266,7 @@ TEST(IoErrors, MeshFaceIndexBeyondTheVerticesAndHugeAxes) {
     EXPECT_NE(m.find("bad.ply: face 0 names vertex 7 but the mesh has 3 vertices"), std::string::npos) << m;
   }
   std::string ok = urdf;
-  ok.replace(ok.find("<visual>"), ok.find("</visual>") + 9 - ok.find("<visual>"), "");
+  ok.replace(ok.find("<collision>"), ok.find("</collision>") + 12 - ok.find("<collision>"), "");
   const Scene s = loadSceneFromString(ok, dir.string(), "axis.urdf");
   EXPECT_TRUE(s.model.joints[0].axis.isApprox(Vec3(1, 1, 0).normalized())) << s.model.joints[0].axis.transpose();
   std::filesystem::remove_all(dir);

@@ -137,6 +137,8 @@ void bindScene(py::module_& m) {
   py::class_<Scene, std::shared_ptr<Scene>> scene(
       m, "Scene", "A loaded scene: model, constraints (contacts, then joint limits), initial state.");
   scene.def_readonly("source", &Scene::source)
+      .def_readonly("warnings", &Scene::warnings,
+                    "What the loader left out and why (a missing visual mesh): file:line: element: reason.")
       .def_property_readonly("nq", [](const Scene& s) { return s.model.nq; })
       .def_property_readonly("nv", [](const Scene& s) { return s.model.nv; })
       .def_property_readonly("nbodies", [](const Scene& s) { return s.model.nbodies; })

@@ -200,3 +200,16 @@ def test_linearize_takes_cyclic_coordinates_by_name_or_index():
     assert np.allclose(by_name.drift, v, atol=1e-15)
     with pytest.raises(KeyError, match="root_joint.spin"):
         appell.linearize(scene, cyclic=["root_joint.spin"])
+
+
+def test_missing_visual_mesh_is_a_warning(tmp_path):
+    urdf = tmp_path / "visual.urdf"
+    urdf.write_text(
+        "<robot name='r'><link name='b'><inertial><mass value='2'/><inertia ixx='1' ixy='0' "
+        "ixz='0' iyy='1' iyz='0' izz='1'/></inertial><visual><geometry><mesh filename='nope.stl'/>"
+        "</geometry></visual></link></robot>")
+    scene = appell.load_scene(urdf)
+    assert len(scene.warnings) == 1
+    assert "visual.urdf:1: <mesh>" in scene.warnings[0]
+    assert "nope.stl" in scene.warnings[0] and "visual only" in scene.warnings[0]
+    assert appell.load_scene(DISK).warnings == []

@@ -114,6 +114,9 @@ struct Scene {
   SimulationSettings settings;
   std::vector<LinkGeometry> geometry;  ///< one per body, index = body
   std::string source;              ///< the file the scene was loaded from
+  /// What the loader left out and why, "file:line: <element>: reason" (a
+  /// visual mesh that is missing or unreadable); `appell` prints them.
+  std::vector<std::string> warnings;
 
   /// Index of the contact with this name, −1 if absent.
   int contactIndex(const std::string& name) const;

@@ -19,6 +19,7 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   Scene scene;
   scene.model = std::move(parsed.model);
   scene.geometry = std::move(parsed.geometry);
+  scene.warnings = std::move(parsed.warnings);
   scene.source = name;
   io::buildSceneContents(src, block, options, scene);
   if (options.check_initial_state)

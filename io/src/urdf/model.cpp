@@ -80,8 +80,16 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
     LinkGeometry geo;
     geo.link = name;
     geo.body = body_of_link[name];
-    for (const UrdfGeometry& v : link.visual)
-      geo.visual.push_back(resolve(src, v, base_dir, options, cache));
+    // A visual mesh only draws the link: one that cannot be found or read
+    // is left out with a warning (as RViz does), not an error; collision
+    // meshes carry contacts and stay errors.
+    for (const UrdfGeometry& v : link.visual) {
+      try {
+        geo.visual.push_back(resolve(src, v, base_dir, options, cache));
+      } catch (const SceneError& e) {
+        robot.warnings.push_back(std::string(e.what()) + " — visual only: the link is not drawn with it");
+      }
+    }
     for (const UrdfGeometry& c : link.collision)
       geo.collision.push_back(resolve(src, c, base_dir, options, cache));
     robot.geometry.push_back(std::move(geo));

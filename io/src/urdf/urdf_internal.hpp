@@ -69,6 +69,7 @@ UrdfRobot readUrdf(const XmlSource& src, const TiXmlElement* robot);
 struct Robot {
   Model model;
   std::vector<LinkGeometry> geometry;
+  std::vector<std::string> warnings;  ///< what was left out and why (Scene::warnings)
 };
 
 /// Builds the model and the link geometry (meshes resolved and, if the
