@@ -5,6 +5,9 @@
 #include <appell/constrained_dynamics.hpp>
 #include <appell/run.hpp>
 
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -34,18 +37,40 @@ int info(int argc, char** argv) {
   std::cout << "scene " << scene.source << "\n"
             << m.nbodies << " bodies, nq = " << m.nq << ", nv = " << m.nv
             << ", total mass " << m.totalMass() << " kg, gravity " << m.gravity.transpose() << "\n\n";
-  std::cout << std::left << std::setw(20) << "body" << std::setw(20) << "joint" << std::setw(11)
-            << "type" << std::setw(20) << "parent" << "mass\n";
+  // Columns as wide as the longest name (CAD exports have long ones).
+  std::size_t wb = 4, wj = 5;
+  for (int i = 0; i < m.nbodies; ++i) {
+    wb = std::max(wb, m.body_names[i].size());
+    wj = std::max(wj, m.joint_names[i].size());
+  }
+  const int cb = static_cast<int>(wb) + 2, cj = static_cast<int>(wj) + 2;
+  std::cout << std::left << std::setw(cb) << "body" << std::setw(cj) << "joint" << std::setw(11)
+            << "type" << std::setw(cb) << "parent" << "mass\n";
   for (int i = 0; i < m.nbodies; ++i)
-    std::cout << std::setw(20) << m.body_names[i] << std::setw(20) << m.joint_names[i]
-              << std::setw(11) << toString(m.joints[i].type) << std::setw(20)
+    std::cout << std::setw(cb) << m.body_names[i] << std::setw(cj) << m.joint_names[i]
+              << std::setw(11) << toString(m.joints[i].type) << std::setw(cb)
               << (m.parent[i] < 0 ? std::string("world") : m.body_names[m.parent[i]])
               << m.inertias[i].mass << "\n";
+  // Links on fixed joints move with the link they hang on: one rigid body
+  // (their inertias combined, as Pinocchio and KDL merge them).
+  bool any_merged = false;
+  for (const RigidGroup& g : rigidGroups(m)) {
+    if (g.fixed.empty()) continue;
+    if (!any_merged) std::cout << "\nmerged (links on fixed joints move as one body with the link they hang on):\n";
+    any_merged = true;
+    std::cout << "  " << m.body_names[g.body] << " +";
+    for (size_t k = 0; k < g.fixed.size(); ++k) std::cout << (k ? ", " : " ") << m.body_names[g.fixed[k]];
+    const Vec3 J = Eigen::SelfAdjointEigenSolver<Mat3>(g.inertia.inertia_com).eigenvalues();
+    const Vec3& c = g.inertia.com;
+    std::cout << ": mass " << g.inertia.mass << " kg, centre of mass (" << c.x() << ", " << c.y()
+              << ", " << c.z() << ") in " << m.body_names[g.body] << ", principal moments ("
+              << J.x() << ", " << J.y() << ", " << J.z() << ") kg m²\n";
+  }
   std::cout << "\n" << scene.contacts.size() << " contacts, " << scene.constraintRows()
             << " constraint rows\n";
   for (size_t k = 0; k < scene.contacts.size(); ++k) {
     const ShapeContact& c = *scene.contacts[k];
-    std::cout << "  " << std::setw(22) << c.name() << " link " << std::setw(14)
+    std::cout << "  " << std::setw(22) << c.name() << " link " << std::setw(cb)
               << m.body_names[c.bodyA()] << " " << std::setw(20) << toString(c.kind()) << " on "
               << std::setw(10) << c.support().name << " shape "
               << scene.contact_origins[k].shape_source;

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include <unistd.h>
 #include <regex>
@@ -92,6 +93,40 @@ TEST(Cli, InfoReportsRowsAndRank) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("nq = 7, nv = 6"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("3 of 3 rows closed, rank 3 (0 redundant)"), std::string::npos) << r.output;
+}
+
+// A CAD-style base: long link names stay in their columns, the links on
+// fixed joints are listed as merged with the combined mass and centre of mass.
+TEST(Cli, InfoAlignsLongNamesAndListsMergedLinks) {
+  const std::string path = std::string(APPELL_BINARY_DIR) + "/cli_merged.urdf";
+  std::ofstream(path) << R"(<robot name="cad">
+  <link name="base_footprint"/>
+  <joint name="base_footprint_to_chassis_link_joint" type="fixed"><parent link="base_footprint"/>
+    <child link="chassis_link_exported_from_solidworks"/><origin xyz="0 0 0.1"/></joint>
+  <link name="chassis_link_exported_from_solidworks"><inertial><mass value="4"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="lidar_joint" type="fixed"><parent link="chassis_link_exported_from_solidworks"/>
+    <child link="lidar"/><origin xyz="0.5 0 0.1"/></joint>
+  <link name="lidar"><inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+</robot>)";
+  const Result r = sh("info " + path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("base_footprint + chassis_link_exported_from_solidworks, lidar: mass 5 kg, "
+                          "centre of mass (0.1, 0, 0.12) in base_footprint"),
+            std::string::npos) << r.output;
+  // Every row of the body table starts its joint column at the same place.
+  std::istringstream lines(r.output);
+  std::string line;
+  std::vector<std::size_t> joint_column;
+  for (bool table = false; std::getline(lines, line);) {
+    if (line.rfind("body ", 0) == 0) table = true;
+    else if (line.empty()) table = false;
+    if (!table) continue;
+    const auto end_of_name = line.find(' ');
+    joint_column.push_back(line.find_first_not_of(' ', end_of_name));
+  }
+  ASSERT_EQ(joint_column.size(), 4u) << r.output;
+  for (std::size_t c : joint_column) EXPECT_EQ(c, joint_column[0]) << r.output;
 }
 
 TEST(Cli, RunConservesEnergyAndWritesTheTrajectory) {

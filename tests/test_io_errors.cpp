@@ -59,8 +59,9 @@ TEST(IoErrors, UnknownJointInSceneBlock) {
 }
 
 TEST(IoErrors, ZeroAndNegativeMass) {
-  expectError("zero_mass.urdf", 5, {"<mass>", "mass must be positive"});
-  expectError("negative_mass.urdf", 5, {"<mass>", "mass must be positive, got -2"});
+  // mass="0" is a massless link; a moving one that carries nothing is refused.
+  expectError("zero_mass.urdf", 3, {"<link name=\"body\">", "zero mass on a moving body"});
+  expectError("negative_mass.urdf", 5, {"<mass>", "mass must not be negative, got -2"});
 }
 
 TEST(IoErrors, InertiaNotPositiveDefinite) {

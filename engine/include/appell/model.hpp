@@ -79,15 +79,32 @@ struct Model {
   double totalMass() const;
 };
 
+/// A body on a moving joint (or a root) with the bodies fixed to it: one
+/// rigid body for the dynamics. URDF tools merge fixed-joint children into
+/// their parent the same way (Pinocchio, KDL); here they stay bodies of the
+/// tree (frames for geometry and contacts) and the validity of the mass
+/// distribution is decided on the group.
+struct RigidGroup {
+  int body = -1;             ///< the moving body (its joint is not fixed)
+  std::vector<int> fixed;    ///< bodies fixed to it (directly or through fixed joints), tree order
+  Inertia inertia;           ///< combined inertia, in `body`'s frame
+};
+/// The groups of bodies that move together, one per body whose joint is not
+/// fixed, in body order. Bodies fixed to the world belong to none. O(n).
+std::vector<RigidGroup> rigidGroups(const Model& model);
+
 /// Error in a model description: which element, and why.
 struct ModelError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Builds a Model body by body. `build()` validates everything (positive mass
-/// unless the body is a massless fixed attachment, positive-definite inertia
-/// satisfying the triangle inequality, finite numbers, unit axes) and throws
-/// ModelError naming the body and the reason.
+/// Builds a Model body by body. `build()` validates everything and throws
+/// ModelError naming the body and the reason: finite numbers, no negative
+/// mass, unit axes, and for every moving body the combined inertia of its
+/// rigid group (itself and the bodies fixed to it, rigidGroups) positive
+/// definite and satisfying the triangle inequality, or massless with massive
+/// bodies beyond its joint. A body on a fixed joint may be massless or
+/// degenerate (a point mass, a sensor frame): only its group is judged.
 class ModelBuilder {
  public:
   /// Adds a body attached to `parent` (−1 = world) by `joint`, whose frame sits

@@ -116,6 +116,21 @@ struct Inertia {
   Inertia transformed(const SE3& A_B) const {
     return {mass, A_B.apply(com), A_B.R * inertia_com * A_B.R.transpose()};
   }
+  /// Two bodies rigidly joined, both given in the same frame: masses add, the
+  /// centre of mass is the mass-weighted mean, and each rotational inertia is
+  /// carried to the new centre by the parallel-axis theorem,
+  ///     J = Σ Jₖ + mₖ (|dₖ|² 1 − dₖ dₖᵀ),   dₖ = cₖ − c.
+  /// (The spatial inertias simply add; this is the same sum in these terms.)
+  Inertia operator+(const Inertia& o) const {
+    const double m = mass + o.mass;
+    if (m == 0) return {0, Vec3::Zero(), inertia_com + o.inertia_com};
+    const Vec3 c = (mass * com + o.mass * o.com) / m;
+    auto shift = [&](const Inertia& k) {
+      const Vec3 d = k.com - c;
+      return Mat3(k.inertia_com + k.mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose()));
+    };
+    return {m, c, shift(*this) + shift(o)};
+  }
 };
 
 /// Rotation matrix for a rotation of `angle` about the unit `axis`.

@@ -180,8 +180,10 @@ Model ModelBuilder::build() const {
     if ((e.placement.R.transpose() * e.placement.R - Mat3::Identity()).norm() > 1e-9)
       fail(e.name, "joint placement rotation is not orthonormal");
     const bool moving = e.type != JointType::Fixed;
-    checkInertia(e.name, e.inertia, !moving || subtree_mass[i] > 0);
-    if (moving && subtree_mass[i] <= 0) fail(e.name, "moving joint carries no mass");
+    if (moving && subtree_mass[i] <= 0)
+      fail(e.name, "zero mass on a moving body with no massive descendants (its joint carries no mass)");
+    if (e.inertia.mass == 0 && e.inertia.inertia_com.norm() != 0)
+      fail(e.name, "zero mass but non-zero rotational inertia");
 
     Joint j;
     j.type = e.type;
@@ -231,8 +233,46 @@ Model ModelBuilder::build() const {
   for (int i = 0; i < n; ++i)
     if (!joint_names.insert(m.joint_names[i]).second)
       fail(m.body_names[i], "joint name '" + m.joint_names[i] + "' is used twice");
+  // The mass distribution is judged per rigid group (a moving body with the
+  // bodies fixed to it), as the dynamics see it: a sensor frame or a point
+  // mass on a fixed joint is fine when its group is a valid rigid body.
+  for (const RigidGroup& g : rigidGroups(m)) {
+    std::string name = m.body_names[g.body];
+    std::string merged;
+    for (int f : g.fixed)
+      if (m.inertias[f].mass > 0 || m.inertias[f].inertia_com.norm() > 0)
+        merged += (merged.empty() ? "'" : ", '") + m.body_names[f] + "'";
+    try {
+      checkInertia(name, g.inertia, subtree_mass[g.body] > 0);
+    } catch (const ModelError& err) {
+      if (merged.empty()) throw;
+      const std::string what = err.what(), head = "body '" + name + "': ";
+      fail(name, "combined inertia with the fixed " + merged + " (merged as ROS tools do): " +
+                     what.substr(what.rfind(head, 0) == 0 ? head.size() : 0));
+    }
+  }
   checkMasslessJoints(m);
   return m;
+}
+
+std::vector<RigidGroup> rigidGroups(const Model& model) {
+  std::vector<RigidGroup> groups;
+  std::vector<int> group_of(model.nbodies, -1);
+  std::vector<SE3> in_group(model.nbodies);  // body frame in its group's moving body
+  for (int i = 0; i < model.nbodies; ++i) {
+    const int p = model.parent[i];
+    if (model.joints[i].type != JointType::Fixed) {
+      group_of[i] = static_cast<int>(groups.size());
+      groups.push_back({i, {}, model.inertias[i]});
+      in_group[i] = SE3::Identity();
+    } else if (p >= 0 && group_of[p] >= 0) {  // parents come first
+      RigidGroup& g = groups[group_of[i] = group_of[p]];
+      in_group[i] = in_group[p] * model.placement[i];
+      g.fixed.push_back(i);
+      g.inertia = g.inertia + model.inertias[i].transformed(in_group[i]);
+    }
+  }
+  return groups;
 }
 
 }  // namespace appell

@@ -98,9 +98,15 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
     robot.model = builder.build();
   } catch (const ModelError& e) {
     std::string msg = e.what();
-    // ModelError names the body; the body is the link of the same name.
+    // ModelError names the body; the body is the link of the same name. A
+    // link's own inertia is pointed at in its <inertia>; a group's combined
+    // one (with fixed links merged) at the moving link.
+    const bool own_inertia = msg.find("combined inertia") == std::string::npos &&
+                             (msg.find("inertia") != std::string::npos ||
+                              msg.find("principal moments") != std::string::npos);
     for (const auto& [name, link] : urdf.links)
-      if (msg.rfind("body '" + name + "'", 0) == 0) fail(src, link.element, msg);
+      if (msg.rfind("body '" + name + "'", 0) == 0)
+        fail(src, own_inertia && link.inertia_element ? link.inertia_element : link.element, msg);
     fail(src, msg);
   }
   return robot;

@@ -142,28 +142,21 @@ Inertia readInertial(const XmlSource& src, const TiXmlElement* inertial) {
   const TiXmlElement* mass = inertial->FirstChildElement("mass");
   if (!mass) fail(src, inertial, "missing <mass>");
   const double m = number(src, mass, "value");
-  if (m <= 0)
-    fail(src, mass, "mass must be positive, got " + std::to_string(m) +
-                        " (leave out <inertial> for a massless link)");
+  if (m < 0) fail(src, mass, "mass must not be negative, got " + std::to_string(m));
   const TiXmlElement* in = inertial->FirstChildElement("inertia");
   if (!in) fail(src, inertial, "missing <inertia>");
   const char* names[6] = {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"};
   double c[6];
   for (int k = 0; k < 6; ++k) c[k] = number(src, in, names[k]);
+  // mass="0" (CAD exporters write it for frames and sensors) is a massless
+  // link, whatever inertia it lists: a rotational inertia without mass is
+  // no mass distribution. Whether the result is a valid rigid body is decided
+  // per rigid group (ModelBuilder: a moving link with the links fixed to it,
+  // merged as ROS tools do), so a point mass or a sensor frame on a fixed
+  // joint loads; errors about one link's own inertia point at its <inertia>.
+  if (m == 0) return Inertia{};
   Mat3 J;
   J << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
-  // A rotational inertia about the centre of mass is positive definite and
-  // its principal moments satisfy I₁ + I₂ ≥ I₃ (each moment is a sum of two
-  // second moments of the mass distribution); otherwise no body has it.
-  const Vec3 d = Eigen::SelfAdjointEigenSolver<Mat3>(J).eigenvalues();
-  std::ostringstream s;
-  s << d(0) << ", " << d(1) << ", " << d(2);
-  if (d.minCoeff() <= 0)
-    fail(src, in, "inertia tensor is not positive definite (principal moments " + s.str() + ")");
-  const double tol = 1e-12 * d.cwiseAbs().maxCoeff();
-  if (d(0) + d(1) < d(2) - tol)
-    fail(src, in, "principal moments " + s.str() +
-                      " violate the triangle inequality I1 + I2 >= I3");
   Inertia I;
   I.mass = m;
   I.com = X.p;
@@ -235,6 +228,7 @@ UrdfLink readLink(const XmlSource& src, const TiXmlElement* l) {
   if (const TiXmlElement* in = l->FirstChildElement("inertial")) {
     if (in->NextSiblingElement("inertial")) fail(src, l, "more than one <inertial>");
     link.inertia = readInertial(src, in);
+    link.inertia_element = in->FirstChildElement("inertia");
   }
   for (const TiXmlElement* v = l->FirstChildElement("visual"); v; v = v->NextSiblingElement("visual")) {
     link.visual.push_back(readGeometry(src, v));

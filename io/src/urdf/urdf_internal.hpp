@@ -32,6 +32,7 @@ struct UrdfLink {
   /// From <inertial>: the inertia tensor rotated into the link frame
   /// (I_link = R I Rᵀ about the centre of mass). Zero mass without <inertial>.
   Inertia inertia;
+  const TiXmlElement* inertia_element = nullptr;  ///< its <inertia>, for messages
   std::vector<UrdfGeometry> visual, collision;  ///< document order
 };
 
