@@ -38,8 +38,9 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
                       joints (by default each finite one is a unilateral
                       constraint: the joint stops or bounces there)
   --quiet             no progress bar
-  --max-energy-error E  stop a passive scene whose relative energy error
-                      (impact losses counted) exceeds E, keeping the last state
+  --max-energy-error E  stop when the work balance (E + impact and friction
+                      losses − work of joint forces and moving supports − E0)
+                      is off by more than E relative, keeping the last state
                       within it: the integration is diverging (default 0.05;
                       inf switches the watch off)
 
@@ -137,9 +138,13 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
       << 1e6 * r.wall_seconds / std::max<long>(1, c.steps) << " µs per step\n"
       << "energy       E0 = " << r.energy0 << " J, max |E "
       << (r.events.empty() ? "" : "+ impact losses ") << (r.friction_work > 0 ? "+ friction work " : "")
-      << "− E0| = " << r.max_energy_deviation
-      << " J (" << r.relativeEnergyDeviation() << " relative)"
-      << (r.passive ? "" : "  [driven scene: energy is not conserved]") << "\n"
+      << (r.passive ? "" : "− work in ") << "− E0| = " << r.max_energy_deviation
+      << " J (" << r.relativeEnergyDeviation() << " relative)\n";
+  if (!r.passive || r.friction_work > 0 || r.impact_energy_loss > 0)
+    out << "work         joint forces " << r.joint_work << " J, moving supports " << r.support_work
+        << " J in; impacts " << r.impact_energy_loss << " J, friction " << r.friction_work
+        << " J out\n";
+  out
       << "residuals    max |Av+b| = " << r.max_velocity_residual
       << ", max |gap| = " << r.max_gap_residual
       << (o.project_velocities ? "" : "  [projection off]") << "\n"

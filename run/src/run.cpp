@@ -125,7 +125,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   // The last state within the divergence bound, to go back to (sized once).
   double t_good = sim.time();
   VecX q_good = sim.q(), v_good = sim.v();
-  const bool watch = s.passive && std::isfinite(options.max_energy_error);
+  const bool watch = std::isfinite(options.max_energy_error);
   run_detail::VertexWatch vertices(scene);  // boxes and meshes on terrain meshes
   bool restored = false;  // went back to the last good state (its loss counters restart)
   while (sim.time() < options.duration * (1 - 1e-12)) {
@@ -135,8 +135,11 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       s.failure = status.message;
       break;
     }
+    const double work_in = sim.jointWork() + sim.supportWork();
     const double deviation =
-        std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - s.energy0);
+        std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - work_in - s.energy0);
+    s.energy_scale = std::max({s.energy_scale, std::abs(sim.energy()), std::abs(sim.jointWork()),
+                               std::abs(sim.supportWork())});
     std::string uncovered;
     const bool diverged = watch && !(deviation <= options.max_energy_error * s.energy_scale);
     if (diverged || !vertices.check(sim, uncovered)) {
@@ -144,7 +147,9 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       if (diverged) {
         // Diverging (an explicit method past its stability limit, a step too
         // long for a stiff moment): stop before the numbers blow up.
-        why << "the energy error of this passive scene reached " << deviation / s.energy_scale
+        why << (s.passive ? "the energy error of this passive scene reached "
+                          : "the work balance of this driven scene (E + losses − work in − E0) is off by ")
+            << deviation / s.energy_scale
             << " (relative) at t = " << sim.time() << " s, beyond the bound "
             << options.max_energy_error
             << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
@@ -154,9 +159,12 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       s.ok = false;
       s.failure = why.str();
       const double impacts = sim.impactEnergyLoss(), friction = sim.frictionWork();
+      const double joint = sim.jointWork(), support = sim.supportWork();
       sim.setState(t_good, q_good, v_good);  // (restarts the loss counters)
       s.impact_energy_loss = impacts;
       s.friction_work = friction;
+      s.joint_work = joint;
+      s.support_work = support;
       restored = true;
       break;
     }
@@ -192,6 +200,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   if (!restored) {
     s.impact_energy_loss = sim.impactEnergyLoss();
     s.friction_work = sim.frictionWork();
+    s.joint_work = sim.jointWork();
+    s.support_work = sim.supportWork();
   }
   s.counters = sim.counters();
   s.partition_changes = sim.partitionChanges();

@@ -130,6 +130,14 @@ class Simulator {
   /// round-off: E + impactEnergyLoss() + frictionWork() is conserved by a
   /// passive scene to that accuracy).
   double frictionWork() const { return friction_work_; }
+  /// Work done on the system since setState() (J), by the same quadrature:
+  /// by the joint forces (∫ τ·v dt) and by constraints that move in time
+  /// (∫ −λᵀb dt: a turntable or a conveyor drives through its rows). The
+  /// balance E + impactEnergyLoss() + frictionWork() − jointWork() −
+  /// supportWork() = E(0) holds for every scene (impacts on moving supports
+  /// are counted in impactEnergyLoss()).
+  double jointWork() const { return joint_work_; }
+  double supportWork() const { return support_work_; }
   /// Whether unilateral constraint `c` is closed now.
   bool isClosed(int constraint) const { return cdata_->isActive(constraint); }
   const SimulatorCounters& counters() const { return counters_; }
@@ -187,6 +195,7 @@ class Simulator {
   std::string state_error_;
   double dissipated_ = 0;
   double friction_work_ = 0, friction_power_ = 0, power_t_ = 0;
+  double joint_work_ = 0, joint_power_ = 0, support_work_ = 0, support_power_ = 0;
 };
 
 }  // namespace appell

@@ -83,7 +83,10 @@ namespace {
   throw ModelError("body '" + body + "': " + why);
 }
 
-bool finite(const Eigen::MatrixBase<auto>& m) { return m.allFinite(); }
+template <typename Derived>
+bool finite(const Eigen::MatrixBase<Derived>& m) {
+  return m.allFinite();
+}
 
 // Rotational inertia about the centre of mass must be symmetric positive
 // definite and its principal moments must satisfy the triangle inequality

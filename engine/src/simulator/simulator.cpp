@@ -62,6 +62,7 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   dissipated_ = 0;
   friction_work_ = 0;
   friction_power_ = 0;
+  joint_work_ = joint_power_ = support_work_ = support_power_ = 0;
   power_t_ = t_;
   if (uni_ && options_.contacts.enabled) {
     // A new state: unilateral constraints with clearance start open, the
@@ -140,8 +141,20 @@ bool Simulator::evaluateEndState(std::string& error) {
       for (const auto& r : uni_->rows)
         if (cdata_->isActive(r.c) && cdata_->isSliding(r.c))
           power += r.mu * std::max(0.0, result_.lambda[r.global]) * cdata_->slide[r.c].slip.norm();
-    if (t_ > power_t_) friction_work_ += 0.5 * (t_ - power_t_) * (friction_power_ + power);
+    // Work put in: by the joint forces, τ·v, and by the constraints, whose
+    // force Aᵀλ has power vᵀAᵀλ = −λᵀb on A v + b = 0 — nonzero only for
+    // rows that move in time (a turntable, a conveyor, a driven joint row).
+    const double joint_power = tau_.dot(v_);
+    const double support_power = -result_.lambda.dot(cdata_->b);
+    if (t_ > power_t_) {
+      const double h = t_ - power_t_;
+      friction_work_ += 0.5 * h * (friction_power_ + power);
+      joint_work_ += 0.5 * h * (joint_power_ + joint_power);
+      support_work_ += 0.5 * h * (support_power_ + support_power);
+    }
     friction_power_ = power;
+    joint_power_ = joint_power;
+    support_power_ = support_power;
     power_t_ = t_;
   }
   return ok;

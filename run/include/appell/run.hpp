@@ -56,10 +56,12 @@ struct RunOptions {
   /// clean stop: the state reached is sampled, the summary says so). For a
   /// SIGINT handler or another thread; null: never.
   const std::atomic<bool>* stop = nullptr;
-  /// Divergence watch (passive scenes, whose E + impact losses + friction
-  /// work is conserved): a step after which |E + losses − E₀| exceeds this fraction
-  /// of the energy scale stops the run as failed, the state kept the last
-  /// one within the bound. ∞ switches it off.
+  /// Divergence watch on the work balance of every scene,
+  ///     E + impact losses + friction work − joint work − support work = E₀
+  /// (passive scenes: no work put in, E + losses is conserved): a step after
+  /// which the balance is off by more than this fraction of the energy scale
+  /// (the largest of |E₀|, T₀, |E|, and the work put in so far) stops the run
+  /// as failed, the state kept the last one within the bound. ∞ switches it off.
   double max_energy_error = 5e-2;
 };
 
@@ -105,11 +107,13 @@ struct RunSummary {
   double wall_seconds = 0;         ///< wall time of the stepping loop
   bool passive = true;             ///< no joint forces, no moving support: E is conserved
   double energy0 = 0;              ///< E at t = 0 (J)
-  double max_energy_deviation = 0; ///< max |E + impact losses + friction work − E₀| (J)
+  double max_energy_deviation = 0; ///< max |E + impact losses + friction work − work in − E₀| (J)
   double impact_energy_loss = 0;   ///< kinetic energy taken by impacts (J)
   double friction_work = 0;        ///< energy taken by sliding friction (J, trapezoidal rule)
+  double joint_work = 0;           ///< work of the joint forces, ∫ τ·v dt (J)
+  double support_work = 0;         ///< work of constraints that move in time, ∫ −λᵀb dt (J)
   std::vector<RunEvent> events;    ///< contact events, in time order
-  double energy_scale = 0;         ///< max(|E₀|, T₀, 1e-12)
+  double energy_scale = 0;         ///< max(|E₀|, T₀, 1e-12), raised by |E| and the work put in as the run goes
   double max_velocity_residual = 0;  ///< max ‖A v + b‖∞, t = 0 included
   double max_gap_residual = 0;       ///< max |g|, t = 0 included
   int max_redundant = 0;           ///< most redundant rows at any sample
