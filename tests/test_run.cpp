@@ -12,6 +12,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 
@@ -180,4 +182,31 @@ TEST(Run, BadOptionsAreRejected) {
   o.output_every = 1;
   o.dt = -1;
   EXPECT_THROW(runScene(scene, o), std::invalid_argument);
+}
+
+// A disk with no spin falls flat. Under dopri5 the step lands on the flat
+// pose (singular geometry, named as such); under RK4 the projection's Newton
+// stalls just before it — and the failure names the same root cause, the
+// contact at the edge of its singular geometry, not only "did not converge".
+TEST(Run, ADiskFallingFlatNamesTheSingularGeometry) {
+  std::ifstream in(std::string(APPELL_SOURCE_DIR) + "/examples/rolling_disk/rolling_disk.urdf");
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string spin = "velocity=\"0.5 0 -5   1.5 0 0.15\"";
+  ASSERT_NE(xml.find(spin), std::string::npos);
+  xml.replace(xml.find(spin), spin.size(), "velocity=\"0.5 0 0   0 0 0\"");
+  LoadOptions lo;
+  lo.project_initial_state = true;
+  const Scene scene = loadSceneFromString(xml, ".", "flat_disk.urdf", lo);
+  for (IntegratorType it : {IntegratorType::RK4, IntegratorType::DormandPrince54}) {
+    RunOptions o = runOptions(scene.settings);
+    o.integrator = it;
+    o.dt = 0.01;
+    o.duration = 3;
+    const RunSummary s = runScene(scene, o, {});
+    ASSERT_FALSE(s.ok) << toString(it);
+    const bool named = s.failure.find("contact 'rim' is at the edge of its singular geometry") != std::string::npos ||
+                       s.failure.find("rim: wheel lying flat") != std::string::npos;
+    EXPECT_TRUE(named) << toString(it) << ": " << s.failure;
+    EXPECT_GT(s.time, 0.9);  // it falls for about a second first
+  }
 }

@@ -20,6 +20,7 @@ void finishPoint(const SE3& pose, const Twist& body, const GaussPoint& g, const 
                  ContactGeometry& out) {
   out.point_body = g.y;
   out.point = pose.apply(g.y);
+  out.margin = g.margin;
   // The geometric contact point moves with the body (material velocity) and
   // slides over the body's surface as the normal turns: d/dt σ(m) = Σ ṁ.
   out.point_rate = body.at(out.point) + pose.R * (g.Sigma * mdot);
@@ -47,6 +48,7 @@ void contactGeometry(const Shape& shape, const SupportSurface& surface,
                      const GeometryOptions& options) {
   out.singular = false;
   out.reason = nullptr;
+  out.margin = 1;
   out.iterations = 0;
   if (!isSmoothContactShape(shape)) {
     out = ContactGeometry{};

@@ -216,6 +216,7 @@ void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
   out.frame.t1 = g.t1;
   out.frame.t2 = g.t2;
   out.frame.gap = g.gap;
+  out.frame.margin = g.margin;
   out.singular = reason != nullptr;
   if (reason) out.singular_reason.assign(reason);
   else out.singular_reason.clear();

@@ -251,6 +251,7 @@ GaussPoint torusPoint(const Vec3& c, const Vec3& a, double R, double r, const Ve
     g.y = c + R * a.unitOrthogonal() + r * m;  // finite stand-in
     return g;
   }
+  g.margin = len;
   const Vec3 u = pm / len;
   const Mat3 P = Mat3::Identity() - a * a.transpose();
   g.y = c + R * u + r * m;

@@ -35,6 +35,7 @@ struct ContactGeometry {
   Vec3 t1_rate = Vec3::Zero(), t2_rate = Vec3::Zero();
   bool singular = false;
   const char* reason = nullptr;       ///< static text, set when singular
+  double margin = 1;                  ///< GaussPoint::margin of the body's point (1: no singular limit)
   int iterations = 0;                 ///< Newton iterations (ellipsoid on a sphere), else 0
 };
 

@@ -176,6 +176,10 @@ struct GaussPoint {
   Mat3 Sigma = Mat3::Zero();
   bool singular = false;
   const char* reason = nullptr;  ///< static text, set when singular
+  /// How far from singular (1: no singular limit near): for a disk or torus
+  /// |P m| — the sine of the angle between the normal and the wheel axis,
+  /// → 0 as the wheel lies flat and the rim's curvature radius R/|P m| blows up.
+  double margin = 1;
 };
 /// `tol` bounds |P m| for disks and tori (below it the wheel lies flat:
 /// every rim point has normal m) and the slack on a cap's edge.

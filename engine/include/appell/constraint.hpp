@@ -49,6 +49,9 @@ struct ContactFrame {
   Vec3 normal = Vec3::UnitZ();      ///< unit normal, world, from the support toward the body
   Vec3 t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
   double gap = 0;                   ///< signed distance (negative: penetration)
+  /// How far the geometry is from a singular configuration (1: none near;
+  /// → 0 as e.g. a wheel lies flat): failures read it to name the cause.
+  double margin = 1;
 };
 
 /// What one constraint writes when evaluated. Capacity is fixed (≤ 6 body rows),

@@ -128,6 +128,32 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
       std::ostringstream os;
       os << "position projection did not converge: max |gap| = " << gmax << " after " << it
          << " Newton iterations (tolerance " << w.opt.gap_tol << ")";
+      // Newton stalls where the rows it solves are close to dependent: say
+      // so, naming the weakest row — the root cause (a wheel nearly flat, a
+      // linkage near a dead point), not the symptom.
+      const double ratio = w.basis.weakestPivotRatio();
+      if (it > 0 && ratio < 1e-4) {
+        const int row = w.row_map[w.basis.pivot(w.basis.rank() - 1)];
+        const int c = cdata.row_constraint[row];
+        os << ": the constraint geometry is close to singular there — the holonomic rows are "
+              "nearly dependent (pivot ratio "
+           << ratio << ", weakest row '" << constraints[c]->name() << "'/"
+           << constraints[c]->rowLabel(row - cdata.offset[c])
+           << "), e.g. a wheel nearly lying flat or a linkage near a dead point";
+      }
+      // A contact whose geometry is near its singular limit (a wheel almost
+      // flat: the rim's curvature radius R/|P m| blows up, and so does
+      // Newton's second-order error) is the cause wherever the rows are.
+      int worst = -1;
+      for (int c : w.with_gaps)
+        if (cdata.isActive(c) && cdata.blocks[c].frame.margin < 1e-3 &&
+            (worst < 0 || cdata.blocks[c].frame.margin < cdata.blocks[worst].frame.margin))
+          worst = c;
+      if (worst >= 0)
+        os << ": contact '" << constraints[worst]->name()
+           << "' is at the edge of its singular geometry (margin "
+           << cdata.blocks[worst].frame.margin
+           << ": a wheel almost lying flat, its normal within that sine of its axis)";
       return fail(os.str());
     }
     prev = gmax;

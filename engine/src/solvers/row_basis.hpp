@@ -14,6 +14,8 @@
 // (Eigen's Householder code runs unblocked below 48 reflectors).
 #pragma once
 
+#include <cmath>
+
 #include <appell/constrained_dynamics.hpp>
 
 #include <Eigen/Cholesky>
@@ -61,6 +63,14 @@ class RowBasis {
 
   /// Original row index of pivot position k (the first rank() are independent).
   int pivot(int k) const { return qr_.colsPermutation().indices()[k]; }
+  /// |R(k,k)| / |R(0,0)| of the last kept pivot, k = rank() − 1 (1 when
+  /// rank ≤ 1): how close the kept, equilibrated rows are to dependence — a
+  /// Newton step on them is as ill-conditioned as its inverse.
+  double weakestPivotRatio() const {
+    if (rank_ <= 1) return 1.0;
+    const auto& R = qr_.matrixQR();
+    return std::abs(R(rank_ - 1, rank_ - 1)) / std::abs(R(0, 0));
+  }
   /// Equilibration factor of row i (0 for a row that is numerically zero).
   double scale(int i) const { return D_[i]; }
 
