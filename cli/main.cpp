@@ -18,7 +18,7 @@ commands:
   view         a self-contained HTML page replaying a run in 3-D (three.js)
   plot         PNG plots of a run's CSV: energy, residuals, contact loads, path
 
-'appell <command> --help' describes each command's options.
+'appell <command> --help' describes each command's options; 'appell --version' prints the version.
 )";
 
 }  // namespace
@@ -28,6 +28,10 @@ int main(int argc, char** argv) {
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
+  }
+  if (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "-V")) {
+    std::cout << "appell " APPELL_VERSION "\n";
+    return 0;
   }
   const std::string cmd = argv[1];
   try {

@@ -42,6 +42,9 @@ TEST(Cli, HelpAndUsage) {
     EXPECT_EQ(r.status, 0) << cmd;
     EXPECT_NE(r.output.find("usage: appell " + std::string(cmd)), std::string::npos) << r.output;
   }
+  const Result version = sh("--version");
+  EXPECT_EQ(version.status, 0);
+  EXPECT_EQ(version.output.rfind("appell 0.", 0), 0u) << version.output;
   EXPECT_EQ(sh("fly").status, 2);
   const Result bad = sh("run " + kDisk + " --formulation quantum");
   EXPECT_EQ(bad.status, 2);

@@ -148,7 +148,7 @@ TEST(IoErrors, InitialStateViolatesTheConstraints) {
   // The ball touches the plane sliding at 1 m/s: the rolling rows' velocity
   // residual is 1. (A ball above the plane is fine: its contact starts open.)
   expectError("initial_violation.urdf", 0, {"initial state violates the constraints",
-                                            "contact 'foot'", "project_initial_state"});
+                                            "contact 'foot'", "appell --project-initial"});
   const std::string msg = errorOf("initial_violation.urdf");
   EXPECT_NE(msg.find("velocity residual |A v + b| = 1 "), std::string::npos) << msg;
 }
@@ -156,7 +156,7 @@ TEST(IoErrors, InitialStateViolatesTheConstraints) {
 TEST(IoErrors, InitialPenetrationNamesTheContact) {
   // The ball's centre is 0.07 m above the plane, radius 0.1: 3 cm in the ground.
   expectError("initial_penetration.urdf", 0, {"contact 'foot' penetrates its support by 0.03",
-                                              "project_initial_state"});
+                                              "appell --project-initial"});
 }
 
 TEST(IoErrors, TerrainMeshWithADegenerateTriangle) {

@@ -20,6 +20,17 @@ std::atomic<bool> g_armed{false};
 std::atomic<long> g_allocations{0};
 }  // namespace
 
+#if defined(APPELL_SANITIZED)
+// Under a sanitizer, which owns malloc, its allocation hook counts instead.
+#include <sanitizer/allocator_interface.h>
+namespace {
+void countingHook(const volatile void*, std::size_t) {
+  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+}
+void ignoreFree(const volatile void*) {}
+[[maybe_unused]] const int g_hooks_installed = __sanitizer_install_malloc_and_free_hooks(countingHook, ignoreFree);
+}  // namespace
+#else
 // Eigen allocates with std::malloc (its aligned_malloc), the standard library
 // with operator new, which ends in malloc too: interpose the C allocator
 // itself (glibc exports the real one as __libc_*).
@@ -63,6 +74,7 @@ int posix_memalign(void** out, std::size_t a, std::size_t n) {
 }
 void free(void* p) { __libc_free(p); }
 }
+#endif  // APPELL_SANITIZED
 
 namespace appell {
 namespace {

@@ -74,7 +74,8 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
       std::ostringstream s;
       s << scene.source << ": initial state: contact '" << con.name()
         << "' penetrates its support by " << -g << " (gap " << g << ", tolerance " << tol
-        << "); raise the body, or load with project_initial_state to push it out";
+        << "); raise the body, or let the loader push it out (appell --project-initial; "
+           "LoadOptions::project_initial_state)";
       throw SceneError(s.str());
     }
   }
@@ -92,7 +93,8 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
       << (w.gap ? " has gap " : " has velocity residual |A v + b| = ") << w.value
       << " (tolerance " << tol << "; max gap " << report.gap_residual
       << ", max velocity residual " << report.velocity_residual
-      << "); fix <initial> or load with project_initial_state";
+      << "); fix <initial>, or let the loader project it onto the constraints (appell "
+           "--project-initial; LoadOptions::project_initial_state)";
     throw SceneError(s.str());
   }
 
