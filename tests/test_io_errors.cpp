@@ -42,6 +42,16 @@ void expectError(const std::string& file, int line, const std::vector<std::strin
     EXPECT_NE(msg.find(p), std::string::npos) << "missing \"" << p << "\" in:\n  " << msg;
 }
 
+// Loads the text `xml` named `name`: the SceneError message, or "(loaded)".
+std::string messageOf(const std::string& xml, const std::string& name) {
+  try {
+    loadSceneFromString(xml, ".", name);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(loaded)";
+}
+
 }  // namespace
 
 TEST(IoErrors, MalformedXml) {
@@ -209,14 +219,7 @@ TEST(IoErrors, DevicesDirectoriesAndUtf16AreNamed) {
 }
 
 TEST(IoErrors, DeepNestingLongValuesAndHugeNumbersAreNamed) {
-  auto message = [](const std::string& xml) {
-    try {
-      loadSceneFromString(xml, ".", "gen.urdf");
-    } catch (const SceneError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(loaded)");
-  };
+  auto message = [](const std::string& xml) { return messageOf(xml, "gen.urdf"); };
   // 10⁵ levels: refused before the (recursive) parser sees them.
   std::string deep = "<robot name=\"r\">";
   for (int i = 0; i < 100000; ++i) deep += "<a>";
@@ -276,14 +279,7 @@ TEST(IoErrors, MeshFaceIndexBeyondTheVerticesAndHugeAxes) {
 // A .urdf.xacro given as it is gets one error, at the first xacro construct,
 // saying to run xacro — not a cascade of "not a number" and unknown elements.
 TEST(IoErrors, UnexpandedXacroIsNamedOnce) {
-  auto message = [](const std::string& xml) {
-    try {
-      loadSceneFromString(xml, ".", "robot.urdf.xacro");
-    } catch (const SceneError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(loaded)");
-  };
+  auto message = [](const std::string& xml) { return messageOf(xml, "robot.urdf.xacro"); };
   const std::string link =
       "<link name=\"a\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" "
       "iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n";
