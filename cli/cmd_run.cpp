@@ -43,6 +43,9 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
                       is off by more than E relative, keeping the last state
                       within it: the integration is diverging (default 0.05;
                       inf switches the watch off)
+  --max-residual R    stop when the constraint residual (max |Av+b|, |gap|)
+                      exceeds R, keeping the last state within it (default
+                      1e-6; inf switches the watch off)
 
 Exit status: 0 success, 1 bad input or an output that could not be written,
 130 interrupted (SIGINT: the summary and the trajectory up to the state reached
@@ -184,7 +187,7 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
-             "max-energy-error"},
+             "max-energy-error", "max-residual"},
             {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kHelp);
@@ -211,6 +214,9 @@ int run(int argc, char** argv) {
     options.max_energy_error = args.text("max-energy-error") == "inf"
                                    ? std::numeric_limits<double>::infinity()
                                    : args.positiveNumber("max-energy-error", 5e-2);
+  if (args.has("max-residual"))
+    options.max_residual = args.text("max-residual") == "inf" ? std::numeric_limits<double>::infinity()
+                                                              : args.positiveNumber("max-residual", 1e-6);
   if (options.output_every < 1) throw UsageError("option --every must be at least 1");
   options.project_positions = options.project_velocities = !args.has("no-projection");
 

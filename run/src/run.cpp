@@ -126,6 +126,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   double t_good = sim.time();
   VecX q_good = sim.q(), v_good = sim.v();
   const bool watch = std::isfinite(options.max_energy_error);
+  const bool watch_residual = std::isfinite(options.max_residual);
   run_detail::VertexWatch vertices(scene);  // boxes and meshes on terrain meshes
   bool restored = false;  // went back to the last good state (its loss counters restart)
   while (sim.time() < options.duration * (1 - 1e-12)) {
@@ -142,9 +143,17 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
                                std::abs(sim.supportWork())});
     std::string uncovered;
     const bool diverged = watch && !(deviation <= options.max_energy_error * s.energy_scale);
-    if (diverged || !vertices.check(sim, uncovered)) {
+    const double residual = std::max(sim.velocityResidual(), sim.gapResidual());
+    const bool drifted = watch_residual && !(residual <= options.max_residual);
+    if (diverged || drifted || !vertices.check(sim, uncovered)) {
       std::ostringstream why;
-      if (diverged) {
+      if (drifted) {
+        why << "the constraint residual reached " << residual << " (|Av+b| "
+            << sim.velocityResidual() << ", |gap| " << sim.gapResidual() << ") at t = " << sim.time()
+            << " s, beyond the bound " << options.max_residual
+            << (options.project_positions ? ": the constraints are no longer held"
+                                          : ": the drift grows without projection — drop --no-projection");
+      } else if (diverged) {
         // Diverging (an explicit method past its stability limit, a step too
         // long for a stiff moment): stop before the numbers blow up.
         why << (s.passive ? "the energy error of this passive scene reached "
@@ -168,7 +177,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       restored = true;
       break;
     }
-    if (watch || vertices.active()) {
+    if (watch || watch_residual || vertices.active()) {
       t_good = sim.time();
       q_good = sim.q();
       v_good = sim.v();

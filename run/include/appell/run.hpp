@@ -63,6 +63,11 @@ struct RunOptions {
   /// (the largest of |E₀|, T₀, |E|, and the work put in so far) stops the run
   /// as failed, the state kept the last one within the bound. ∞ switches it off.
   double max_energy_error = 5e-2;
+  /// Residual watch: a step after which max(‖A v + b‖∞, max |gap|) exceeds
+  /// this stops the run as failed, the state kept the last one within it —
+  /// drift the projection no longer removes (or, with projection off, drift
+  /// grown past what the user accepts). ∞ switches it off.
+  double max_residual = 1e-6;
 };
 
 /// The scene's own settings as run options. Throws std::invalid_argument for
