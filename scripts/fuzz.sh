@@ -32,6 +32,7 @@ fi
 args=("$@")
 [ ${#args[@]} -eq 0 ] && args=(-runs=1000000)
 # Bounded: inputs up to 64 KiB, 10 s per input, 2 GiB of memory.
-ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+# Leaks inside third-party libraries are suppressed by name (fuzz/lsan.supp).
+ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=fuzz/lsan.supp UBSAN_OPTIONS=print_stacktrace=1 \
   "./build-fuzz/fuzz/$target" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
   -artifact_prefix=build-fuzz/findings/ -print_final_stats=1 "${args[@]}" "$corpus"
