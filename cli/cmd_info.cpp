@@ -85,6 +85,13 @@ int info(int argc, char** argv) {
       std::cout << "  " << std::setw(22) << l->name() << " " << (l->side() == LimitSide::Lower ? "q ≥ " : "q ≤ ")
                 << l->bound() << ", restitution " << l->restitution() << "\n";
   }
+  if (!scene.couplings.empty()) {
+    std::cout << scene.couplings.size() << " mimic coupling" << (scene.couplings.size() > 1 ? "s" : "")
+              << " (holonomic joint-space rows):\n";
+    for (const auto& c : scene.couplings)
+      std::cout << "  " << std::setw(22) << c->name() << " " << m.joint_names[c->follower()] << " = "
+                << c->multiplier() << " · " << m.joint_names[c->leader()] << " + " << c->offset() << "\n";
+  }
   if (scene.constraintRows() > 0) {
     // The simulator's own start (tree solver, O(n)): which unilateral rows
     // are closed, and the rank the solver decides with its tolerances on

@@ -82,7 +82,11 @@ void printContacts(std::ostream& out, const RunSummary& r) {
   for (const ContactStats& e : r.contacts) {
     out << "  " << std::left << std::setw(24) << e.name << std::right;
     if (e.normal_row < 0) {
-      out << " (no normal row)\n";
+      if (e.reaction_row >= 0 && e.min_reaction <= e.max_reaction)
+        out << std::setprecision(4) << " reaction " << e.min_reaction << " … " << e.max_reaction
+            << " (generalized force on its joint: N·m or N)\n";
+      else
+        out << " (no normal row)\n";
       continue;
     }
     if (e.min_normal > e.max_normal) {  // no closed sample

@@ -24,6 +24,7 @@ std::vector<ContactStats> contactStats(const Scene& scene) {
       if (kind == RowKind::Normal) e.normal_row = offset + r;
       if (isTangential(kind)) e.tangential_rows.push_back(offset + r);
     }
+    if (e.normal_row < 0 && c.rows() == 1) e.reaction_row = offset;
     offset += c.rows();
     stats.push_back(std::move(e));
   }
@@ -33,6 +34,10 @@ std::vector<ContactStats> contactStats(const Scene& scene) {
 void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
             const ConstraintData& cdata) {
   for (ContactStats& e : stats) {
+    if (e.reaction_row >= 0) {
+      e.min_reaction = std::min(e.min_reaction, lambda[e.reaction_row]);
+      e.max_reaction = std::max(e.max_reaction, lambda[e.reaction_row]);
+    }
     if (e.normal_row < 0) continue;
     if (!cdata.isActive(cdata.row_constraint[e.normal_row])) {
       ++e.open_samples;

@@ -213,3 +213,28 @@ def test_missing_visual_mesh_is_a_warning(tmp_path):
     assert "visual.urdf:1: <mesh>" in scene.warnings[0]
     assert "nope.stl" in scene.warnings[0] and "visual only" in scene.warnings[0]
     assert appell.load_scene(DISK).warnings == []
+
+
+def test_mimic_coupling_reaction(tmp_path):
+    # A gear pair: the follower (inertia 0.08) turns at −0.4 × the leader
+    # (0.02) under 0.3 N·m on the leader; the coupling's torque on the
+    # follower is I_f · (−0.4) · α with α = τ / (I_l + 0.16 I_f).
+    urdf = tmp_path / "gears.urdf"
+    inertia = "<inertia ixx='{0}' ixy='0' ixz='0' iyy='{0}' iyz='0' izz='{1}'/>"
+    urdf.write_text(
+        "<robot name='gears'><link name='world'/>"
+        "<link name='a'><inertial><mass value='1'/>" + inertia.format(0.02, 0.02) + "</inertial></link>"
+        "<link name='b'><inertial><mass value='1'/>" + inertia.format(0.05, 0.08) + "</inertial></link>"
+        "<joint name='ja' type='continuous'><parent link='world'/><child link='a'/><axis xyz='0 0 1'/></joint>"
+        "<joint name='jb' type='continuous'><parent link='world'/><child link='b'/><origin xyz='1 0 0'/>"
+        "<axis xyz='0 0 1'/><mimic joint='ja' multiplier='-0.4'/></joint>"
+        "<appell><effort joint='ja' value='0.3'/></appell></robot>")
+    scene = appell.load_scene(urdf)
+    assert scene.mimic_names == scene.constraint_names == ["jb_mimic"]
+    assert scene.row_labels == ["jb_mimic.coupling"]
+    sim = appell.Simulation(scene, integrator="dopri5", rtol=1e-12, atol=1e-12)
+    sim.advance_to(1.0)
+    alpha = 0.3 / (0.02 + 0.16 * 0.08)
+    assert sim.lambdas[0] == pytest.approx(0.08 * -0.4 * alpha, rel=1e-10)
+    assert sim.q[1] == pytest.approx(-0.4 * sim.q[0], abs=1e-12)
+    assert sim.q[0] == pytest.approx(0.5 * alpha, rel=1e-10)

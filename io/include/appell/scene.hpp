@@ -10,6 +10,7 @@
 #include <appell/constraint.hpp>
 #include <appell/constraint_set.hpp>
 #include <appell/contacts.hpp>
+#include <appell/joint_coupling.hpp>
 #include <appell/joint_limit.hpp>
 #include <appell/model.hpp>
 
@@ -96,7 +97,7 @@ struct VertexGroup {
 struct Scene {
   Model model;
   /// One constraint per contact, in the order of `contacts`, then the joint
-  /// limits, in the order of `joint_limits`.
+  /// limits, in the order of `joint_limits`, then the mimic couplings.
   ConstraintList constraints;
   /// The declared contacts in document order: the same objects as `constraints`
   /// (a contact's description is its spec(); the link is
@@ -108,6 +109,9 @@ struct Scene {
   /// side (joint_limit.hpp; off with LoadOptions::joint_limits = false): the
   /// same objects as constraints[contacts.size() …].
   std::vector<std::shared_ptr<const JointLimit>> joint_limits;
+  /// URDF <mimic> couplings (joint_coupling.hpp), in document order of the
+  /// following joints: the same objects as the constraints after the limits.
+  std::vector<std::shared_ptr<const JointCoupling>> couplings;
   std::vector<Support> supports;
   VecX q0, v0;                     ///< initial state (nq, nv)
   VecX tau;                        ///< constant generalized forces (nv), from <effort>

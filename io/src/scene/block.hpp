@@ -65,7 +65,8 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
 
 /// Turns the declarations into the scene's supports, contacts, constraints,
 /// initial state and efforts, against the built model and link geometry.
-void buildSceneContents(const XmlSource& src, const AppellBlock& block, const LoadOptions& options,
+void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const AppellBlock& block,
+                        const LoadOptions& options,
                         Scene& scene);
 
 }  // namespace appell::io

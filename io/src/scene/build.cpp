@@ -132,10 +132,34 @@ void setJointState(const XmlSource& src, const Model& model, const JointStateDec
   }
 }
 
+// A follower whose <initial> does not set it starts where its leader puts it,
+// q_f = m q_l + o and v_f = m v_l, as ROS's joint_state_publisher places mimic
+// joints. Leaders first: a chain settles in as many passes as it is long. A
+// follower the block does set is left alone — if it contradicts its leader,
+// the initial-state check names the coupling.
+void followLeaders(const AppellBlock& block, Scene& scene) {
+  const Model& model = scene.model;
+  std::vector<bool> q_given(model.nbodies, false), v_given(model.nbodies, false);
+  for (const JointStateDecl& d : block.initial) {
+    const int j = model.jointIndex(d.joint);
+    q_given[j] = q_given[j] || d.position.has_value();
+    v_given[j] = v_given[j] || d.velocity.has_value();
+  }
+  for (std::size_t pass = 0; pass < scene.couplings.size(); ++pass) {
+    for (const auto& c : scene.couplings) {
+      const Joint& f = model.joints[c->follower()];
+      const Joint& l = model.joints[c->leader()];
+      if (!q_given[c->follower()])
+        scene.q0[f.idx_q] = c->multiplier() * scene.q0[l.idx_q] + c->offset();
+      if (!v_given[c->follower()]) scene.v0[f.idx_v] = c->multiplier() * scene.v0[l.idx_v];
+    }
+  }
+}
+
 }  // namespace
 
-void buildSceneContents(const XmlSource& src, const AppellBlock& block, const LoadOptions& options,
-                        Scene& scene) {
+void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const AppellBlock& block,
+                        const LoadOptions& options, Scene& scene) {
   const Model& model = scene.model;
   for (const SupportDecl& d : block.supports) {
     Support support = d.support;
@@ -201,9 +225,23 @@ void buildSceneContents(const XmlSource& src, const AppellBlock& block, const Lo
       }
     }
   }
+  for (const std::string& name : urdf.joint_order) {
+    const UrdfJoint& j = urdf.joints.at(name);
+    if (!j.mimic) continue;
+    try {
+      auto coupling = std::make_shared<const JointCoupling>(
+          model, model.jointIndex(name), model.jointIndex(j.mimic->joint), j.mimic->multiplier,
+          j.mimic->offset);
+      scene.constraints.push_back(coupling);
+      scene.couplings.push_back(std::move(coupling));
+    } catch (const std::invalid_argument& e) {
+      fail(src, j.mimic->element, e.what());
+    }
+  }
   scene.q0 = neutralConfiguration(model);
   scene.v0 = VecX::Zero(model.nv);
   for (const JointStateDecl& d : block.initial) setJointState(src, model, d, scene.q0, scene.v0);
+  followLeaders(block, scene);
   scene.tau = VecX::Zero(model.nv);
   for (const EffortDecl& e : block.efforts) {
     const int j = model.jointIndex(e.joint);

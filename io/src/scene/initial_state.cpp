@@ -33,7 +33,9 @@ Worst worstRow(const ConstraintData& cd, const VecX& v) {
 std::string describeRow(const Scene& scene, const ConstraintData& cd, int row) {
   const int c = cd.row_constraint[row];
   const Constraint& con = *scene.constraints[c];
-  return "contact '" + con.name() + "' row '" + con.rowLabel(row - cd.offset[c]) + "'";
+  const bool contact = c < static_cast<int>(scene.contacts.size());
+  return std::string(contact ? "contact '" : "constraint '") + con.name() + "' row '" +
+         con.rowLabel(row - cd.offset[c]) + "'";
 }
 
 [[noreturn]] void singular(const Scene& scene, const ConstraintData& cd) {

@@ -21,7 +21,7 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   scene.geometry = std::move(parsed.geometry);
   scene.warnings = std::move(parsed.warnings);
   scene.source = name;
-  io::buildSceneContents(src, block, options, scene);
+  io::buildSceneContents(src, urdf, block, options, scene);
   if (options.check_initial_state)
     checkInitialState(scene, options.project_initial_state, options.initial_state_tolerance);
   return scene;

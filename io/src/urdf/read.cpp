@@ -292,10 +292,15 @@ UrdfJoint readJoint(const XmlSource& src, const TiXmlElement* j) {
   if (!ce) fail(src, j, "missing <child>");
   joint.parent = text(src, pe, "link");
   joint.child = text(src, ce, "link");
-  if (j->FirstChildElement("mimic"))
-    fail(src, j->FirstChildElement("mimic"),
-         "mimic joints are not supported (the coupling is a holonomic constraint this "
-         "loader does not create)");
+  if (const TiXmlElement* m = j->FirstChildElement("mimic")) {
+    if (m->NextSiblingElement("mimic")) fail(src, m->NextSiblingElement("mimic"), "a joint has one <mimic>");
+    UrdfMimic mimic;
+    mimic.element = m;
+    mimic.joint = text(src, m, "joint");
+    mimic.multiplier = number(src, m, "multiplier", 1.0);
+    mimic.offset = number(src, m, "offset", 0.0);
+    joint.mimic = mimic;
+  }
   joint.origin = origin(src, j);
   if (const TiXmlElement* a = j->FirstChildElement("axis")) {
     Vec3 axis = vec3(src, a, "xyz");
@@ -327,6 +332,40 @@ UrdfJoint readJoint(const XmlSource& src, const TiXmlElement* j) {
 }
 
 }  // namespace
+
+// A <mimic> names a one-degree-of-freedom joint of this robot, and the
+// couplings do not go round in a circle (a joint that follows itself through
+// others is either redundant or contradicts itself). Chains are fine: each
+// link of the chain is its own constraint row.
+void checkMimics(const XmlSource& src, const UrdfRobot& ix) {
+  auto oneDof = [](JointType t) {
+    return t == JointType::Revolute || t == JointType::Continuous || t == JointType::Prismatic;
+  };
+  for (const std::string& name : ix.joint_order) {
+    const UrdfJoint& j = ix.joints.at(name);
+    if (!j.mimic) continue;
+    const UrdfMimic& m = *j.mimic;
+    if (!oneDof(j.type))
+      fail(src, m.element, std::string("a ") + toString(j.type) +
+                               " joint cannot mimic (only revolute, continuous and prismatic joints)");
+    const auto leader = ix.joints.find(m.joint);
+    if (leader == ix.joints.end()) fail(src, m.element, "mimics joint '" + m.joint + "', which is not declared");
+    if (m.joint == name) fail(src, m.element, "joint '" + name + "' mimics itself");
+    if (!oneDof(leader->second.type))
+      fail(src, m.element, "mimics '" + m.joint + "', a " + toString(leader->second.type) +
+                               " joint (only revolute, continuous and prismatic joints can be followed)");
+    // Follow the chain of leaders; at most one step per joint.
+    std::string at = m.joint;
+    for (std::size_t steps = 0; steps <= ix.joint_order.size(); ++steps) {
+      const UrdfJoint& l = ix.joints.at(at);
+      if (!l.mimic || !ix.joints.count(l.mimic->joint)) break;
+      at = l.mimic->joint;
+      if (at == name)
+        fail(src, m.element, "the mimic couplings of '" + name + "' come back to it (a cycle through '" +
+                                 m.joint + "'): one joint of the cycle must lead");
+    }
+  }
+}
 
 UrdfRobot readUrdf(const XmlSource& src, const TiXmlElement* robot) {
   UrdfRobot ix;
@@ -409,6 +448,7 @@ UrdfRobot readUrdf(const XmlSource& src, const TiXmlElement* robot) {
     if (!seen.count(n))
       fail(src, ix.links.at(n).element, "link '" + n + "' is not connected to the root '" + ix.root +
                                     "' (its joints form a cycle)");
+  checkMimics(src, ix);
   return ix;
 }
 

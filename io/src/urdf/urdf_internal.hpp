@@ -14,6 +14,7 @@
 #include "urdf/xml_util.hpp"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,14 @@ struct UrdfLink {
   std::vector<UrdfGeometry> visual, collision;  ///< document order
 };
 
+/// <mimic joint multiplier offset>: this joint follows `joint` as
+/// q = multiplier · q_joint + offset (joint_coupling.hpp).
+struct UrdfMimic {
+  const TiXmlElement* element = nullptr;
+  std::string joint;
+  double multiplier = 1, offset = 0;
+};
+
 struct UrdfJoint {
   const TiXmlElement* element = nullptr;
   std::string name, parent, child;
@@ -43,6 +52,7 @@ struct UrdfJoint {
   SE3 origin;                      ///< joint frame in the parent link's frame
   Vec3 axis = Vec3::UnitX();       ///< URDF's default when <axis> is absent
   JointLimits limits;              ///< infinite without <limit>
+  std::optional<UrdfMimic> mimic;
 };
 
 /// What readUrdf found: every link and joint by name, in document order, and

@@ -75,7 +75,8 @@ struct RunOptions {
 /// step or tolerance.
 RunOptions runOptions(const SimulationSettings& settings);
 
-/// One contact's reactions over the run (only for constraints with a normal row).
+/// One constraint's reactions over the run: a contact's normal load and friction
+/// demand (constraints with a normal row), a one-row coupling's reaction.
 struct ContactStats {
   std::string name;                ///< the constraint's name
   double mu = std::numeric_limits<double>::infinity();  ///< the scene's μ (∞: unchecked)
@@ -88,6 +89,11 @@ struct ContactStats {
   /// The friction demand exceeded μ or the normal pulled.
   bool flagged() const { return pulling > 0 || over_mu > 0; }
   long open_samples = 0;           ///< samples with the contact open (in flight)
+  /// A one-row constraint that is not a contact (a mimic coupling): λ of its
+  /// row, the generalized force it applies to its joint, and its range.
+  int reaction_row = -1;
+  double min_reaction = std::numeric_limits<double>::infinity(),
+         max_reaction = -std::numeric_limits<double>::infinity();
 };
 
 /// A contact event of the run (Simulator::events()), named.
