@@ -85,6 +85,17 @@ int info(int argc, char** argv) {
       std::cout << "  " << std::setw(22) << l->name() << " " << (l->side() == LimitSide::Lower ? "q ≥ " : "q ≤ ")
                 << l->bound() << ", restitution " << l->restitution() << "\n";
   }
+  if (!scene.actuators.empty()) {
+    std::cout << scene.actuators.size() << " actuator" << (scene.actuators.size() > 1 ? "s" : "") << ":\n";
+    for (const Actuator& a : scene.actuators) {
+      std::cout << "  " << std::setw(22) << a.name << " " << toString(a.type) << " servo on "
+                << m.joint_names[a.joint] << ", kp " << a.kp << ", kv " << a.kv << ", |τ| ≤ " << a.effort_limit
+                << ", set-point";
+      for (std::size_t k = 0; k < a.setpoint.t.size(); ++k)
+        std::cout << (k ? "," : "") << " " << a.setpoint.value[k] << " at t=" << a.setpoint.t[k];
+      std::cout << "\n";
+    }
+  }
   if (!scene.couplings.empty()) {
     std::cout << scene.couplings.size() << " mimic coupling" << (scene.couplings.size() > 1 ? "s" : "")
               << " (holonomic joint-space rows):\n";

@@ -116,6 +116,7 @@ INSTANTIATE_TEST_SUITE_P(
                       RunCase{"ellipsoid/ellipsoid.urdf", 0, true},
                       RunCase{"diff_drive/diff_drive.urdf", 1, false},
                       RunCase{"diff_drive/diff_drive_turn.urdf", 1, false},
+                      RunCase{"diff_drive/diff_drive_servo.urdf", 1, false},
                       RunCase{"car/car.urdf", 3, true},
                       RunCase{"ntrailer/ntrailer3.urdf", 0, false}),
     [](const ::testing::TestParamInfo<RunCase>& p) {

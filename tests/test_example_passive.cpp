@@ -303,6 +303,7 @@ INSTANTIATE_TEST_SUITE_P(AllExamples, ExampleFormulations,
                                            "ellipsoid/ellipsoid.urdf",
                                            "diff_drive/diff_drive.urdf",
                                            "diff_drive/diff_drive_turn.urdf",
+                                           "diff_drive/diff_drive_servo.urdf",
                                            "car/car.urdf",
                                            "ntrailer/ntrailer3.urdf"),
                          [](const ::testing::TestParamInfo<const char*>& p) {

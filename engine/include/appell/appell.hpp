@@ -26,6 +26,7 @@
 #include <appell/appell_maggi.hpp>
 
 // Drift projection and the simulation loop.
+#include <appell/actuators.hpp>
 #include <appell/joint_coupling.hpp>
 #include <appell/joint_limit.hpp>
 #include <appell/projection.hpp>

@@ -7,12 +7,14 @@
 // the file, except `source` for messages.
 #pragma once
 
+#include <appell/actuators.hpp>
 #include <appell/constraint.hpp>
 #include <appell/constraint_set.hpp>
 #include <appell/contacts.hpp>
 #include <appell/joint_coupling.hpp>
 #include <appell/joint_limit.hpp>
 #include <appell/model.hpp>
+#include <appell/simulator.hpp>
 
 #include <array>
 #include <memory>
@@ -115,12 +117,23 @@ struct Scene {
   std::vector<Support> supports;
   VecX q0, v0;                     ///< initial state (nq, nv)
   VecX tau;                        ///< constant generalized forces (nv), from <effort>
+  /// Servos from <actuator> (actuators.hpp), adding to `tau`; each one's
+  /// effort limit is its own or its joint's URDF <limit effort>.
+  std::vector<Actuator> actuators;
   SimulationSettings settings;
   std::vector<LinkGeometry> geometry;  ///< one per body, index = body
   std::string source;              ///< the file the scene was loaded from
   /// What the loader left out and why, "file:line: <element>: reason" (a
   /// visual mesh that is missing or unreadable); `appell` prints them.
   std::vector<std::string> warnings;
+
+  /// The joint forces the scene declares — the constant efforts plus the
+  /// actuators — as Simulator::setJointForces takes them (empty when the
+  /// scene declares none). The function reads this scene's model: the scene
+  /// must outlive it, as it must outlive a Simulator made on it.
+  Simulator::JointForces jointForces() const;
+  /// Whether any joint force is declared (a driven scene: energy is not conserved).
+  bool driven() const;
 
   /// Index of the contact with this name, −1 if absent.
   int contactIndex(const std::string& name) const;

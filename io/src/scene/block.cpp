@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <sstream>
 
 namespace appell::io {
 
@@ -241,6 +242,54 @@ JointStateDecl parseJointState(const XmlSource& src, const TiXmlElement* e) {
   return d;
 }
 
+// <actuator name="drive" joint="j" type="velocity" kv="2" setpoint="3"/>, or
+// with <setpoint t="…" value="…"/> children for a schedule (docs/scene-format.md).
+ActuatorDecl parseActuator(const XmlSource& src, const TiXmlElement* e) {
+  allowOnly(src, e, {"name", "joint", "type", "kp", "kv", "effort_limit", "setpoint"});
+  ActuatorDecl d;
+  d.element = e;
+  d.joint = text(src, e, "joint");
+  Actuator& a = d.actuator;
+  a.name = text(e, "name", d.joint);
+  if (a.name.empty()) fail(src, e, "empty actuator name");
+  const std::string type = text(src, e, "type");
+  if (type == "position") a.type = ActuatorType::Position;
+  else if (type == "velocity") a.type = ActuatorType::Velocity;
+  else fail(src, e, "unknown actuator type '" + type + "' (known: position, velocity)");
+  a.kp = number(src, e, "kp", 0.0);
+  a.kv = number(src, e, "kv", 0.0);
+  if (has(e, "effort_limit")) {
+    a.effort_limit = positive(src, e, "effort_limit");
+    d.own_limit = true;
+  }
+  const bool constant = has(e, "setpoint");
+  if (constant) {
+    a.setpoint.t = {0.0};
+    a.setpoint.value = {number(src, e, "setpoint")};
+  }
+  for (const TiXmlElement* p = e->FirstChildElement(); p; p = p->NextSiblingElement()) {
+    if (std::string(p->Value()) != "setpoint")
+      fail(src, p, "unknown element in <actuator> (only <setpoint t value> is allowed)");
+    if (constant) fail(src, p, "give the set-point either as the 'setpoint' attribute or as <setpoint> elements, not both");
+    allowOnly(src, p, {"t", "value"});
+    const double t = number(src, p, "t");
+    if (!a.setpoint.t.empty() && !(t > a.setpoint.t.back()))
+    {
+      std::ostringstream m;
+      m << "set-point time " << t << " does not come after the one before (" << a.setpoint.t.back()
+        << "); times must increase";
+      fail(src, p, m.str());
+    }
+    a.setpoint.t.push_back(t);
+    a.setpoint.value.push_back(number(src, p, "value"));
+  }
+  if (a.setpoint.t.empty()) {  // hold position 0 / stand still
+    a.setpoint.t = {0.0};
+    a.setpoint.value = {0.0};
+  }
+  return d;
+}
+
 SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
   allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation"});
   SimulationSettings s;
@@ -295,6 +344,12 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
     } else if (tag == "effort") {
       allowOnly(src, e, {"joint", "value"});
       b.efforts.push_back({e, text(src, e, "joint"), numbers(src, e, "value")});
+    } else if (tag == "actuator") {
+      ActuatorDecl d = parseActuator(src, e);
+      for (const ActuatorDecl& o : b.actuators)
+        if (o.actuator.name == d.actuator.name)
+          fail(src, e, "actuator name '" + d.actuator.name + "' is used twice");
+      b.actuators.push_back(std::move(d));
     } else if (tag == "joint_limits") {
       allowOnly(src, e, {"enabled", "restitution"});
       if (b.limits_element) fail(src, e, "<joint_limits> is given twice");
@@ -313,7 +368,7 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
       b.settings = parseSimulation(src, e);
     } else {
       fail(src, e, "unknown element <" + tag +
-                       "> in <appell> (known: gravity, support, contact, initial, effort, joint_limits, simulation)");
+                       "> in <appell> (known: gravity, support, contact, initial, effort, actuator, joint_limits, simulation)");
     }
   }
   for (const ContactDecl& c : b.contacts)

@@ -45,6 +45,16 @@ struct EffortDecl {
   std::vector<double> value;
 };
 
+/// <actuator name joint type kp kv effort_limit setpoint> with optional
+/// <setpoint t value> children (actuators.hpp); the joint is resolved and the
+/// effort limit completed from the URDF when the scene is built.
+struct ActuatorDecl {
+  const TiXmlElement* element = nullptr;
+  std::string joint;
+  Actuator actuator;                ///< joint index and URDF limit not yet set
+  bool own_limit = false;           ///< effort_limit given
+};
+
 struct AppellBlock {
   const TiXmlElement* element = nullptr;  ///< null when the URDF has no <appell>
   Vec3 gravity{0, 0, -9.81};
@@ -52,6 +62,7 @@ struct AppellBlock {
   std::vector<ContactDecl> contacts;
   std::vector<JointStateDecl> initial;
   std::vector<EffortDecl> efforts;
+  std::vector<ActuatorDecl> actuators;
   SimulationSettings settings;
   /// <joint_limits enabled="true|false" restitution="e"/>
   const TiXmlElement* limits_element = nullptr;

@@ -253,6 +253,21 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
                                std::to_string(e.value.size()));
     for (int k = 0; k < joint.nv; ++k) scene.tau(joint.idx_v + k) += e.value[k];
   }
+  for (const ActuatorDecl& d : block.actuators) {
+    Actuator a = d.actuator;
+    a.joint = model.jointIndex(d.joint);
+    if (a.joint < 0) fail(src, d.element, "unknown joint '" + d.joint + "'");
+    // The URDF's <limit effort> bounds the servo unless it names its own.
+    if (!d.own_limit && std::isfinite(model.joints[a.joint].limits.effort) &&
+        model.joints[a.joint].limits.effort > 0)
+      a.effort_limit = model.joints[a.joint].limits.effort;
+    try {
+      a.validate(model);
+    } catch (const std::invalid_argument& e) {
+      fail(src, d.element, e.what());
+    }
+    scene.actuators.push_back(std::move(a));
+  }
   scene.settings = block.settings;
 }
 

@@ -39,6 +39,22 @@ int Scene::contactIndex(const std::string& name) const {
   return -1;
 }
 
+Simulator::JointForces Scene::jointForces() const {
+  const bool constant = tau.size() > 0 && tau.size() == model.nv && tau.cwiseAbs().maxCoeff() > 0;
+  if (!constant && actuators.empty()) return {};
+  // Copies of the forces (a later change to the scene does not reach a
+  // running simulation); the model by reference (its owner outlives us).
+  return [model = &model, tau = constant ? tau : VecX::Zero(model.nv), actuators = actuators](
+             double t, const VecX& q, const VecX& v, VecX& out) {
+    out = tau;
+    applyActuators(*model, actuators, t, q, v, out);
+  };
+}
+
+bool Scene::driven() const {
+  return !actuators.empty() || (tau.size() && tau.cwiseAbs().maxCoeff() > 0);
+}
+
 int Scene::constraintRows() const {
   int m = 0;
   for (const auto& c : constraints) m += c->rows();
