@@ -4,6 +4,7 @@
 
 #include <appell/configuration.hpp>
 #include <appell/vertex_contacts.hpp>
+#include <appell/wheel_fit.hpp>
 
 #include <cmath>
 #include <sstream>
@@ -22,8 +23,30 @@ std::string geometryLabel(int k, const Geometry& g) {
 // gives a tyre radius); with `rim_points` it is a cylinder standing on a face,
 // touching with its rim polygons. A sphere is itself. Boxes and meshes touch
 // with their vertices (vertex_contacts.hpp).
+// A rolling (or knife-edge) contact on a mesh wheel: the smooth shape fitted
+// about the wheel joint's axle (wheel_fit.hpp), said in `label`.
+Shape fittedWheel(const XmlSource& src, const ContactDecl& c, const Geometry& g, const Joint& joint,
+                  std::string& label) {
+  std::vector<Vec3> link_frame(g.mesh->vertices.size());
+  for (std::size_t k = 0; k < link_frame.size(); ++k) link_frame[k] = g.origin.R * g.mesh->vertices[k] + g.origin.p;
+  try {
+    const WheelFit f = fitWheel(link_frame, Vec3::Zero(), joint.axis);
+    std::ostringstream s;
+    s << label << ", fitted " << (f.torus ? "torus" : "disk") << " about the joint axle: radius "
+      << f.outer_radius;
+    if (f.torus) s << ", tyre radius " << f.tube_radius;
+    s << ", largest deviation " << f.max_deviation << " over " << f.tread_vertices << " tread vertices";
+    label = s.str();
+    return f.shape;
+  } catch (const std::invalid_argument& e) {
+    fail(src, c.element, label + ": " + e.what());
+  }
+}
+
+bool rollsOnAWheel(ContactKind kind) { return kind != ContactKind::Sliding; }
+
 Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry& g,
-                      const std::string& label) {
+                      const Joint& joint, std::string& label) {
   const Vec3 axis = g.origin.R.col(2);
   if (c.rim_points > 0 && g.type != GeometryType::Cylinder)
     fail(src, c.element, "'rim_points' applies to a cylinder collision, not " + label);
@@ -46,6 +69,9 @@ Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry
     case GeometryType::Mesh: {
       if (c.tyre_radius > 0) fail(src, c.element, "'tyre_radius' needs a cylinder, not " + label);
       if (!g.mesh) fail(src, c.element, label + ": the mesh '" + g.mesh_path + "' was not loaded");
+      if (rollsOnAWheel(c.spec.kind) && c.rim_points == 0 &&
+          (joint.type == JointType::Revolute || joint.type == JointType::Continuous))
+        return fittedWheel(src, c, g, joint, label);
       Mesh m{g.mesh_path, g.mesh_scale, g.origin, g.mesh->vertices, g.mesh->triangles};
       return m;
     }
@@ -54,7 +80,7 @@ Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry
 }
 
 Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometry& geo,
-                   std::string& source) {
+                   const Joint& joint, std::string& source) {
   if (c.explicit_shape) {
     if (!c.collision.empty()) fail(src, c.element, "give either 'collision' or an explicit shape, not both");
     source = "explicit";
@@ -86,7 +112,7 @@ Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometr
     if (pick < 0) pick = 0;
   }
   source = geometryLabel(pick, col[pick]);
-  return shapeOfGeometry(src, c, col[pick], source);
+  return shapeOfGeometry(src, c, col[pick], joint, source);
 }
 
 void setJointState(const XmlSource& src, const Model& model, const JointStateDecl& d, VecX& q,
@@ -182,7 +208,8 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
       if (s.name == c.support) spec.support = s;
     ContactOrigin origin;
     origin.line = c.element->Row();
-    spec.shape = contactShape(src, c, scene.geometry[spec.body], origin.shape_source);
+    spec.shape = contactShape(src, c, scene.geometry[spec.body], model.joints[spec.body],
+                              origin.shape_source);
     std::vector<std::shared_ptr<ShapeContact>> made;
     try {
       if (isSmoothContactShape(spec.shape))
