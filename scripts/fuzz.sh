@@ -1,25 +1,23 @@
 #!/usr/bin/env bash
 # Fuzzes the scene loader (and the mesh loader) with libFuzzer under ASan and
-# UBSan, built with Debian's clang into ./build-fuzz.
+# UBSan, built with Debian's clang into ./build-asan (shared with
+# scripts/sanitize.sh: one sanitized library serves both).
 #   scripts/fuzz.sh                    10⁶ executions of the scene loader
 #   scripts/fuzz.sh -runs=N            N executions
 #   scripts/fuzz.sh -max_total_time=S  S seconds
 #   FUZZ_TARGET=fuzz_mesh_loader scripts/fuzz.sh …   the mesh loader instead
 # Seeds: every URDF of examples/ and tests/data (scene loader), every mesh of
 # examples/ and tests/data (mesh loader: first byte = format). A crash leaves
-# crash-<sha1> in build-fuzz/findings; copy it to tests/data/fuzz-regressions/
+# crash-<sha1> in build-asan/findings; copy it to tests/data/fuzz-regressions/
 # (test_fuzz_regressions loads each file there under every build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-bash scripts/apt-install.sh fuzz clang libclang-rt-14-dev
 target=${FUZZ_TARGET:-fuzz_scene_loader}
-CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DAPPELL_FUZZ=ON -DAPPELL_SANITIZE=address,undefined -DAPPELL_BUILD_TESTS=OFF \
-  -DAPPELL_BUILD_BENCHMARKS=OFF -DAPPELL_BUILD_EXAMPLES=OFF -DAPPELL_BUILD_PYTHON=OFF >/dev/null
-cmake --build build-fuzz -j"$(nproc)" --target "$target"
-corpus=build-fuzz/corpus/$target
-mkdir -p "$corpus" build-fuzz/findings
+bash scripts/configure-asan.sh
+cmake --build build-asan -j"$(nproc)" --target "$target"
+corpus=build-asan/corpus/$target
+mkdir -p "$corpus" build-asan/findings
 if [ "$target" = fuzz_scene_loader ]; then
   find examples tests/data -name '*.urdf' -size -64k -exec cp {} "$corpus"/ \;
 else
@@ -34,5 +32,5 @@ args=("$@")
 # Bounded: inputs up to 64 KiB, 10 s per input, 2 GiB of memory.
 # Leaks inside third-party libraries are suppressed by name (fuzz/lsan.supp).
 ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=fuzz/lsan.supp UBSAN_OPTIONS=print_stacktrace=1 \
-  "./build-fuzz/fuzz/$target" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
-  -artifact_prefix=build-fuzz/findings/ -print_final_stats=1 "${args[@]}" "$corpus"
+  "./build-asan/fuzz/$target" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
+  -artifact_prefix=build-asan/findings/ -print_final_stats=1 "${args[@]}" "$corpus"
