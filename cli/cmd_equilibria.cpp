@@ -17,10 +17,15 @@ const char* kHelp = R"(usage: appell equilibria SCENE.urdf [options]
 
 Solves Q(q) + Aᵀ(q) λ = 0 with the holonomic gaps g(q) = 0 for (q, λ), keeping
 the multipliers as unknowns, so equilibria held only by nonholonomic reactions
-(of the "second kind", Emelyanova & Fufaev) are found too. Starts from the
-scene's initial configuration and from random perturbations of it.
+(of the "second kind", Emelyanova & Fufaev) are found too, and says of each
+whether it is of the first kind (the holonomic reactions alone hold it) or of
+the second. Starts from the scene's initial configuration, from it turned
+half a turn (each rotation joint's angle + π, a floating base about the
+vertical: a sleigh's two blade orientations) and from random perturbations.
+Equilibria on one connected set of equilibria (a sleigh resting anywhere
+along a line) are reported as one set.
 
-  --starts N        number of starting guesses (default 8; the first is q0)
+  --starts N        number of random starting guesses (default 8; the first is q0)
   --spread S        size of the perturbations in local coordinates (default 0.5)
   --seed K          random seed (default 1)
   --tol TOL         scaled residual tolerance (default 1e-10)
@@ -46,6 +51,28 @@ int equilibria(int argc, char** argv) {
   std::uniform_real_distribution<double> u(-spread, spread);
   std::vector<VecX> guesses{scene.q0};
   VecX theta(m.nv), q(m.nq);
+  // The symmetric guesses a user expects: half a turn of each rotation
+  // coordinate (θ slot of a revolute or continuous joint, a planar joint's
+  // angle, a floating base's yaw about the vertical −g).
+  for (int j = 0; j < m.nbodies; ++j) {
+    const Joint& joint = m.joints[j];
+    theta.setZero();
+    switch (joint.type) {
+      case JointType::Revolute: case JointType::Continuous: theta[joint.idx_v] = M_PI; break;
+      case JointType::Planar: theta[joint.idx_v + 2] = M_PI; break;
+      case JointType::Floating: {
+        // θ's rotation part is about the body axes: the vertical in the body frame.
+        const Vec3 up = m.gravity.norm() > 0 ? Vec3(-m.gravity.normalized()) : Vec3(Vec3::UnitZ());
+        const Quat qb(scene.q0[joint.idx_q + 6], scene.q0[joint.idx_q + 3], scene.q0[joint.idx_q + 4],
+                      scene.q0[joint.idx_q + 5]);
+        theta.segment<3>(joint.idx_v) = M_PI * (qb.conjugate() * up);
+        break;
+      }
+      default: continue;
+    }
+    retract(m, scene.q0, theta, q);
+    guesses.push_back(q);
+  }
   for (int k = 1; k < starts; ++k) {
     for (int i = 0; i < m.nv; ++i) theta[i] = u(rng);
     retract(m, scene.q0, theta, q);
@@ -57,12 +84,23 @@ int equilibria(int argc, char** argv) {
   const MultiStartResult res = findEquilibria(m, scene.constraints, guesses, opt);
 
   const std::vector<std::string> cols = trajectoryColumns(m, scene.constraints);
-  std::cout << "scene " << scene.source << ": " << starts << " starting guesses, "
-            << res.distinct.size() << " distinct equilibria found\n";
+  std::cout << "scene " << scene.source << ": " << guesses.size() << " starting guesses, "
+            << res.distinct.size() << " distinct equilibria found on " << res.sets << " equilibrium set"
+            << (res.sets == 1 ? "" : "s") << "\n";
   for (size_t n = 0; n < res.distinct.size(); ++n) {
     const EquilibriumResult& e = res.runs[res.distinct[n]];
     std::cout << "\nequilibrium " << n + 1 << " (from guess " << res.distinct[n] + 1 << ", "
-              << e.iterations << " iterations, residual " << e.residual << ")\n"
+              << e.iterations << " iterations, residual " << e.residual << ") on set " << res.set[n] + 1;
+    for (size_t k = 0; k < n; ++k)
+      if (res.set[k] == res.set[n]) {
+        std::cout << " with equilibrium " << k + 1;
+        break;
+      }
+    std::cout << "\n  "
+              << (e.second_kind ? "second kind: held only with nonholonomic reactions (without them it "
+                                  "would move; holonomic rows alone leave "
+                                : "first kind: the holonomic reactions alone hold it (residual ")
+              << e.holonomic_residual << ")\n"
               << "  local dimension of the equilibrium set: " << e.manifold_dimension
               << "; rank A = " << e.rank_A << " (" << e.redundant_rows << " redundant rows)\n  q:";
     for (int i = 0; i < m.nq; ++i)

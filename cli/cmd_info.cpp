@@ -19,7 +19,9 @@ namespace {
 const char* kHelp = R"(usage: appell info SCENE.urdf [--package-path DIRS] [--project-initial] [--no-joint-limits]
 
 Prints the bodies (joint type, parent, mass), the degrees of freedom (nq, nv),
-every contact with its kind, support, shape and rows, and at the initial state
+the links merged on fixed joints, the meshes (triangles, vertices), every
+contact with its kind, support, shape and rows, the joint limits, actuators
+and mimic couplings, and at the initial state
 the rank of the constraint rows: redundant rows (e.g. a four-wheeled car) and
 the residuals of the initial state.
 )";
@@ -65,6 +67,28 @@ int info(int argc, char** argv) {
     std::cout << ": mass " << g.inertia.mass << " kg, centre of mass (" << c.x() << ", " << c.y()
               << ", " << c.z() << ") in " << m.body_names[g.body] << ", principal moments ("
               << J.x() << ", " << J.y() << ", " << J.z() << ") kg m²\n";
+  }
+  // Meshes: what each link draws and collides with, and its size.
+  bool any_mesh = false;
+  for (const LinkGeometry& g : scene.geometry) {
+    for (const auto* list : {&g.visual, &g.collision}) {
+      for (const Geometry& geo : *list) {
+        if (geo.type != GeometryType::Mesh) continue;
+        if (!any_mesh) std::cout << "\nmeshes:\n";
+        any_mesh = true;
+        std::cout << "  " << std::setw(cb) << g.link << (list == &g.visual ? "visual    " : "collision ")
+                  << geo.mesh_uri;
+        if (geo.mesh)
+          std::cout << ": " << geo.mesh->triangles.size() << " triangles, " << geo.mesh->vertices.size()
+                    << " vertices";
+        else
+          std::cout << ": not loaded";
+        if (geo.mesh_scale != Vec3::Ones())
+          std::cout << ", scale (" << geo.mesh_scale.x() << ", " << geo.mesh_scale.y() << ", "
+                    << geo.mesh_scale.z() << ")";
+        std::cout << "\n";
+      }
+    }
   }
   std::cout << "\n" << scene.contacts.size() << " contacts, " << scene.constraintRows()
             << " constraint rows\n";

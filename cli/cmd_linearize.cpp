@@ -2,6 +2,8 @@
 // equilibrium or a steady motion, in independent coordinates.
 #include "commands.hpp"
 
+#include <appell/output.hpp>
+
 #include <appell/appell.hpp>
 #include <appell/equilibria.hpp>
 #include <appell/linearization.hpp>
@@ -22,11 +24,13 @@ scene's initial state and prints the eigenvalues.
   --equilibrium       first find the equilibrium nearest the initial configuration
                       (v = 0) and linearize there
   --cyclic C1,C2,...  cyclic (ignorable) coordinates for a steady motion, by
-                      name: <joint> or <joint>.<coord> as 'appell info' and
-                      the CSV name the velocities (e.g. root.vx names the
-                      floating base's x position coordinate's rate slot)
+                      name as the CSV's q: or v: columns name them: a joint
+                      (revolute, prismatic), root_joint.x or root_joint.vx
+                      (the floating base's world x), a planar joint's .theta
+                      or .omega; rotations of a floating base by .wx .wy .wz
   --formulation F     {formulations} (default: the scene's)
-  --zero-tol TOL      |μ| below which an eigenvalue counts as zero (default 1e-4)
+  --zero-tol TOL      |μ| below TOL × max(1, max |μ|) counts as zero, and a real
+                      part below it is not growth (default 1e-4)
 
 Exit status 3 when the reference is not an equilibrium / steady motion.
   --package-path DIRS
@@ -59,11 +63,15 @@ int linearize(int argc, char** argv) {
   }
   LinearizationOptions lo;
   if (scene.tau.size() == m.nv) lo.tau = scene.tau;
-  const std::vector<std::string> names = velocityNames(m);
   for (const std::string& c : args.list("cyclic")) {
-    auto it = std::find(names.begin(), names.end(), c);
-    if (it == names.end()) throw UsageError("--cyclic: no coordinate named '" + c + "'");
-    lo.cyclic.push_back(static_cast<int>(it - names.begin()));
+    int k;
+    try {
+      k = localCoordinateIndex(m, c);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--cyclic: ") + e.what());
+    }
+    if (k < 0) throw UsageError("--cyclic: no coordinate named '" + c + "' (names as the CSV's q: and v: columns)");
+    lo.cyclic.push_back(k);
   }
   Formulation form;
   try {
@@ -88,17 +96,21 @@ int linearize(int argc, char** argv) {
   std::cout << "\neigenvalues (real, imag):\n" << std::setprecision(8);
   for (const auto& z : ev)
     std::cout << "  " << std::setw(16) << z.real() << "  " << std::setw(16) << z.imag() << "\n";
-  const int zeros = countZeroEigenvalues(r, zero_tol);
+  // Relative to the eigenvalues' scale: round-off in a fast system's
+  // eigenvalues is larger than 1e-4 in absolute terms, and is not instability.
+  double scale = 1.0;
+  for (const auto& z : ev) scale = std::max(scale, std::abs(z));
+  const double tol = zero_tol * scale;
+  const int zeros = countZeroEigenvalues(r, tol);
   const double max_re = ev.empty() ? 0.0 : ev.front().real();
-  std::cout << zeros << " zero eigenvalues (|μ| < " << zero_tol << ")\n";
+  std::cout << zeros << " zero eigenvalues (|μ| < " << tol << " = zero-tol × max(1, max |μ|))\n";
   // A verdict needs a true equilibrium / steady motion; otherwise say why not.
-  const double scale = std::max(1.0, ev.empty() ? 0.0 : std::abs(ev.front()));
   if (r.steady_residual > 1e-6 * scale || r.constraint_residual > 1e-8) {
     std::cout << "no stability verdict: the reference state is not an equilibrium or steady motion"
               << " (steady residual " << r.steady_residual << "); try --equilibrium or --cyclic\n";
     return 3;
   }
-  std::cout << (max_re > zero_tol ? "unstable: largest real part " + std::to_string(max_re)
+  std::cout << (max_re > tol ? "unstable: largest real part " + std::to_string(max_re)
                                   : std::string("no exponentially growing mode (to within the zero tolerance)"))
             << "\n";
   return 0;

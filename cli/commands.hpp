@@ -25,8 +25,5 @@ Scene loadFromArgs(const Args& args, bool check_initial = true);
 /// canonical names of integratorTable() and formulationTable() ("a | b | c").
 std::string helpText(const char* text);
 
-/// Velocity-coordinate names, one per entry of v (and of the local coordinates θ):
-/// "<joint>" or "<joint>.<coord>".
-std::vector<std::string> velocityNames(const Model& model);
 
 }  // namespace appell::cli

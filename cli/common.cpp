@@ -32,26 +32,4 @@ std::string helpText(const char* text) {
   return s;
 }
 
-std::vector<std::string> velocityNames(const Model& model) {
-  std::vector<std::string> names;
-  for (int i = 0; i < model.nbodies; ++i) {
-    const Joint& j = model.joints[i];
-    const std::string& n = model.joint_names[i];
-    switch (j.type) {
-      case JointType::Fixed: break;
-      case JointType::Planar:
-        for (const char* c : {"vx", "vy", "omega"}) names.push_back(n + "." + c);
-        break;
-      case JointType::Floating:
-        for (const char* c : {"wx", "wy", "wz", "vx", "vy", "vz"}) names.push_back(n + "." + c);
-        break;
-      case JointType::Ball:
-        for (const char* c : {"wx", "wy", "wz"}) names.push_back(n + "." + c);
-        break;
-      default: names.push_back(n);
-    }
-  }
-  return names;
-}
-
 }  // namespace appell::cli

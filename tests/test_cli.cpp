@@ -156,9 +156,15 @@ TEST(Cli, EquilibriumOfTheUprightDisk) {
   // An upright disk at rest is an equilibrium: its centre of mass is above the
   // contact, the normal load is m g = 9.81 N and nothing else pushes. The set of
   // such states is 4-dimensional: position (x, y), heading and spin angle are free.
+  // The guesses: q0 and q0 turned half a turn about the vertical — two
+  // distinct equilibria on one set (turning the heading stays on it), both
+  // of the first kind (the normal force alone holds the disk).
   const Result r = sh("equilibria " + kDisk + " --starts 1");
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("1 distinct equilibria found"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("2 distinct equilibria found on 1 equilibrium set"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("on set 1 with equilibrium 1"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("first kind"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("second kind"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("local dimension of the equilibrium set: 4"), std::string::npos) << r.output;
   EXPECT_NEAR(field(r.output, R"(rim/normal\s+([-+0-9.e]+))"), 9.81, 1e-9) << r.output;
 }
@@ -241,4 +247,51 @@ TEST(Cli, RunWarnsWhenTheConstraintsLeaveNoFreedom) {
   EXPECT_NE(r.output.find("warning: " + bad + ": the constraints leave 0 independent velocities"),
             std::string::npos)
       << r.output;
+}
+
+// --cyclic takes a coordinate by its position name as well as by its
+// velocity's (the floating base's world x is root_joint.x or root_joint.vx):
+// the same linearization either way; a quaternion component is refused
+// saying what to name instead.
+TEST(Cli, CyclicCoordinatesByPositionOrVelocityName) {
+  const Result by_pos = sh("linearize " + kDisk + " --cyclic root_joint.x,root_joint.y,root_joint.wz");
+  const Result by_vel = sh("linearize " + kDisk + " --cyclic root_joint.vx,root_joint.vy,root_joint.wz");
+  EXPECT_EQ(by_pos.status, by_vel.status) << by_pos.output;
+  EXPECT_NE(by_pos.output.find("eigenvalues"), std::string::npos) << by_pos.output;
+  EXPECT_EQ(by_pos.output, by_vel.output);
+  const Result bad = sh("linearize " + kDisk + " --cyclic root_joint.qz");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("quaternion component"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("root_joint.wx"), std::string::npos) << bad.output;
+}
+
+// appell info lists every mesh with its size (the diff drive's wheels: the
+// same 2176-triangle tyre as STL and as Collada).
+TEST(Cli, InfoListsMeshesWithTriangleCounts) {
+  const Result r = sh("info " + std::string(APPELL_SOURCE_DIR) + "/examples/diff_drive/diff_drive.urdf");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("meshes:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("meshes/wheel.stl: 2176 triangles"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("meshes/wheel.dae: 2176 triangles"), std::string::npos) << r.output;
+}
+
+// The Chaplygin sleigh on the incline with its centre of mass over the blade
+// (examples/sleigh/sleigh.urdf with a = 0): it rests wherever it stands with
+// its blade across the slope — held by the blade's lateral reaction, an
+// equilibrium of the second kind (Emelyanova & Fufaev) — on a 2-dimensional
+// set (any position on the plane), one set per blade orientation. Many
+// starting points, two sets.
+TEST(Cli, SleighOverItsBladeRestsOnTwoSetsOfTheSecondKind) {
+  std::ifstream in(std::string(APPELL_SOURCE_DIR) + "/examples/sleigh/sleigh.urdf");
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (std::string::size_type at; (at = xml.find(R"(xyz="0.3 0 0.1")")) != std::string::npos;)
+    xml.replace(at, 15, R"(xyz="0 0 0.1")");
+  const std::string path = ::testing::TempDir() + "sleigh_over_blade.urdf";
+  std::ofstream(path) << xml;
+  const Result r = sh("equilibria " + path + " --starts 6");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("on 2 equilibrium sets"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("second kind: held only with nonholonomic reactions"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("first kind"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("local dimension of the equilibrium set: 2"), std::string::npos) << r.output;
 }

@@ -15,6 +15,9 @@ namespace {
 
 struct Compared {
   double vdot = 0, reaction = 0, lambda = 0, constraint = 0;
+  /// The dense KKT solver's errors in double against the same long-double
+  /// reference: what the problem's own conditioning costs any double solver.
+  double kkt_vdot = 0, kkt_lambda = 0;
   bool full_rank = false;
   int rank = 0, ref_rank = 0;
 };
@@ -41,6 +44,10 @@ Compared compare(const System& s, const SolverOptions& opt = {}) {
   c.lambda = relErr(out.lambda, ref.lambda);  // the unique minimum-norm λ, redundant rows or not
   c.rank = out.rank;
   c.ref_rank = ref.rank;
+  ConstrainedResult kkt;
+  makeSolver(Formulation::Multipliers, s.model, list)->solve(s.model, data, list, cd, s.q, s.v, s.tau, kkt);
+  c.kkt_vdot = relErr(kkt.vdot, ref.vdot);
+  c.kkt_lambda = relErr(kkt.lambda, ref.lambda);
   return c;
 }
 
@@ -90,9 +97,10 @@ TEST(TreeSolver, RowsAJointBarelyMovesAreHandedUpWithCompliance) {
   // A row whose own joint moves it with a small pivot σ, while an ancestor
   // moves it well. Resolving it at the small pivot would lose ~eps/σ⁴; the
   // solver hands it up with its compliance instead, and must match the dense
-  // solvers with no refinement. (Below σ ≈ 10⁻⁵ the problem itself is ill
-  // conditioned: the dense KKT solver in double then misses the long-double
-  // reference by ~10⁻¹⁰ too.)
+  // solvers with no refinement: within 1e-10 (λ: 1e-9) of the long-double
+  // reference, or within twice the dense KKT solver's own error in double
+  // where the problem's conditioning costs more than that (at σ = 10⁻⁴ some
+  // draws cost the KKT solver 2·10⁻¹⁰ in v̇ and 2·10⁻⁹ in λ).
   std::mt19937 rng(17);
   int checked = 0;
   for (double sigma : {3e-2, 1e-3, 1e-4}) {
@@ -104,10 +112,12 @@ TEST(TreeSolver, RowsAJointBarelyMovesAreHandedUpWithCompliance) {
           makeConsistent(s, rng);
           const Compared c = compare(s);
           ++checked;
-          EXPECT_LT(c.vdot, 1e-10) << "sigma=" << sigma << " n=" << n << " rep=" << rep;
-          EXPECT_LT(c.reaction, 1e-10) << "sigma=" << sigma << " n=" << n << " rep=" << rep;
+          EXPECT_LT(c.vdot, std::max(1e-10, 2 * c.kkt_vdot))
+              << "sigma=" << sigma << " n=" << n << " rep=" << rep << " kkt " << c.kkt_vdot;
+          EXPECT_LT(c.reaction, std::max(1e-10, 2 * c.kkt_vdot)) << "sigma=" << sigma << " n=" << n << " rep=" << rep;
           EXPECT_EQ(c.rank, c.ref_rank) << "sigma=" << sigma << " n=" << n;
-          EXPECT_LT(c.lambda, 1e-9) << "sigma=" << sigma << " n=" << n << " rep=" << rep;
+          EXPECT_LT(c.lambda, std::max(1e-9, 2 * c.kkt_lambda))
+              << "sigma=" << sigma << " n=" << n << " rep=" << rep << " kkt " << c.kkt_lambda;
         }
       }
     }

@@ -38,6 +38,36 @@ std::string csvField(const std::string& s) {
 
 }  // namespace
 
+std::vector<std::string> coordinateNames(const Model& model, bool velocities) {
+  std::vector<std::string> names;
+  for (int j = 0; j < model.nbodies; ++j)
+    for (const std::string& c : coordNames(model.joints[j].type, velocities))
+      names.push_back(model.joint_names[j] + c);
+  return names;
+}
+
+int localCoordinateIndex(const Model& model, const std::string& name) {
+  for (int j = 0; j < model.nbodies; ++j) {
+    const Joint& joint = model.joints[j];
+    const std::string& jn = model.joint_names[j];
+    if (name.compare(0, jn.size(), jn) != 0) continue;
+    const std::string coord = name.substr(jn.size());
+    const std::vector<std::string> vel = coordNames(joint.type, true), pos = coordNames(joint.type, false);
+    for (std::size_t k = 0; k < vel.size(); ++k)
+      if (coord == vel[k]) return joint.idx_v + static_cast<int>(k);
+    for (std::size_t k = 0; k < pos.size(); ++k) {
+      if (coord != pos[k]) continue;
+      if (pos[k].rfind(".q", 0) == 0)
+        throw std::invalid_argument("'" + name + "' is a quaternion component, not a coordinate of its own; name a "
+                                    "rotation slot (" + jn + ".wx, .wy, .wz: rotations about the body axes)");
+      // Floating: θ = (rotation, world translation), so .x .y .z are slots 3–5;
+      // planar and one-degree-of-freedom joints: position k is slot k.
+      return joint.idx_v + static_cast<int>(joint.type == JointType::Floating ? k + 3 : k);
+    }
+  }
+  return -1;
+}
+
 std::vector<std::string> trajectoryColumns(const Model& model, const ConstraintList& constraints) {
   std::vector<std::string> cols = {"time"};
   for (const char* prefix : {"q:", "v:"})

@@ -33,16 +33,21 @@ EquilibriumOptions equilibriumOptions(const Scene& s, const std::optional<VecX>&
   return o;
 }
 
-/// Cyclic coordinates by velocity index or by velocity name (Scene.velocity_names).
+/// Cyclic coordinates by velocity index, or by name — a velocity's
+/// (Scene.velocity_names) or a position's (localCoordinateIndex, output.hpp).
 std::vector<int> cyclicIndices(const Scene& s, const py::iterable& cyclic) {
-  const std::vector<std::string> names = coordinateNames(s.model, true);
   std::vector<int> out;
   for (py::handle c : cyclic) {
     if (py::isinstance<py::str>(c)) {
       const std::string n = c.cast<std::string>();
-      auto it = std::find(names.begin(), names.end(), n);
-      if (it == names.end()) throw py::key_error("no velocity coordinate named '" + n + "'");
-      out.push_back(static_cast<int>(it - names.begin()));
+      int k;
+      try {
+        k = localCoordinateIndex(s.model, n);
+      } catch (const std::invalid_argument& e) {
+        throw py::key_error(e.what());
+      }
+      if (k < 0) throw py::key_error("no coordinate named '" + n + "'");
+      out.push_back(k);
     } else {
       out.push_back(c.cast<int>());
     }
@@ -66,13 +71,19 @@ void bindResults(py::module_& m) {
       .def_readonly("rank_A", &EquilibriumResult::rank_A)
       .def_readonly("redundant_rows", &EquilibriumResult::redundant_rows)
       .def_readonly("manifold_dimension", &EquilibriumResult::manifold_dimension)
+      .def_readonly("second_kind", &EquilibriumResult::second_kind,
+                    "Held only with nonholonomic reactions (Emelyanova & Fufaev's second kind).")
+      .def_readonly("holonomic_residual", &EquilibriumResult::holonomic_residual,
+                    "min over the holonomic rows' λ of |Q + A_hᵀ λ_h|∞.")
       .def_readonly("tangent", &EquilibriumResult::tangent)
       .def_readonly("row_labels", &EquilibriumResult::row_labels)
       .def("__bool__", [](const EquilibriumResult& r) { return r.converged; })
       .def("__repr__", [](const EquilibriumResult& r) { return "<EquilibriumResult: " + r.message + ">"; });
   py::class_<MultiStartResult>(m, "MultiStartResult")
       .def_readonly("runs", &MultiStartResult::runs, "One EquilibriumResult per guess, in order.")
-      .def_readonly("distinct", &MultiStartResult::distinct, "Indices of converged runs, duplicates removed.");
+      .def_readonly("distinct", &MultiStartResult::distinct, "Indices of converged runs, duplicates removed.")
+      .def_readonly("set", &MultiStartResult::set, "Per distinct equilibrium, the equilibrium set it lies on.")
+      .def_readonly("sets", &MultiStartResult::sets, "Number of equilibrium sets found.");
   py::class_<LinearizationResult>(m, "LinearizationResult")
       .def_readonly("dimension", &LinearizationResult::dimension)
       .def_readonly("retained", &LinearizationResult::retained)

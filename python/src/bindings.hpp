@@ -4,6 +4,7 @@
 // share.
 #pragma once
 
+#include <appell/output.hpp>
 #include <appell/scene.hpp>
 
 #include <pybind11/pybind11.h>
@@ -26,9 +27,5 @@ int constraintIndex(const Scene& scene, py::handle which);
 int bodyIndex(const Scene& scene, py::handle which);
 /// The scene's constant joint forces when it has them (size nv), else empty.
 VecX sceneTau(const Scene& scene);
-
-/// Names of the position (nq) or velocity (nv) coordinates, as the CSV
-/// columns name them without their "q:" / "v:" prefix.
-std::vector<std::string> coordinateNames(const Model& model, bool velocities);
 
 }  // namespace appell::python

@@ -55,14 +55,6 @@ VecX sceneTau(const Scene& scene) {
   return scene.tau.size() == scene.model.nv ? scene.tau : VecX();
 }
 
-std::vector<std::string> coordinateNames(const Model& model, bool velocities) {
-  const std::string prefix = velocities ? "v:" : "q:";
-  std::vector<std::string> names;
-  for (const std::string& c : trajectoryColumns(model, {}))
-    if (c.rfind(prefix, 0) == 0) names.push_back(c.substr(2));
-  return names;
-}
-
 namespace {
 
 LoadOptions loadOptions(const std::vector<std::string>& package_paths, bool use_ros_package_path,

@@ -62,6 +62,14 @@ struct EquilibriumResult {
   int manifold_dimension = 0;
   MatX tangent;            ///< nv × manifold_dimension, orthonormal basis in θ at q
   std::vector<std::string> row_labels;  ///< "<constraint>/<row>" per λ entry
+  /// Emelyanova & Fufaev's distinction: an equilibrium of the *second kind*
+  /// cannot be held by the holonomic rows' reactions alone (min over λ_h of
+  /// ‖Q + A_hᵀ λ_h‖∞, `holonomic_residual`, exceeds the tolerance): some
+  /// nonholonomic row (a knife edge's lateral row, a rolling contact's
+  /// tangential rows) must push. One of the first kind would stay at rest
+  /// with the nonholonomic constraints removed.
+  bool second_kind = false;
+  double holonomic_residual = 0;  ///< N, N·m
 };
 
 /// Newton-type search for an equilibrium from `q_guess`. Never reports a
@@ -74,6 +82,14 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
 struct MultiStartResult {
   std::vector<EquilibriumResult> runs;  ///< one per guess, in order
   std::vector<int> distinct;            ///< indices of converged runs, duplicates removed
+  /// Per entry of `distinct`, the equilibrium set it lies on (0, 1, … in
+  /// order of first appearance): two equilibria share a set when the path
+  /// between them (q = retract(q_a, s·θ_ab), s ∈ (0, 1)) stays on equilibria
+  /// — every sampled point converges to an equilibrium within a small
+  /// fraction of |θ_ab| of itself — as for a sleigh that can rest anywhere
+  /// along a line of the incline.
+  std::vector<int> set;
+  int sets = 0;
 };
 
 /// Runs findEquilibrium from every guess; converged runs whose configurations

@@ -230,6 +230,27 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
     out.lambda = VecX();
   }
   out.redundant_rows = m - out.rank_A;
+  // First or second kind: can the holonomic rows alone hold Q?
+  {
+    std::vector<int> hrows;
+    for (int r = 0; r < m; ++r)
+      if (cd.holonomic[r]) hrows.push_back(r);
+    if (static_cast<int>(hrows.size()) == m) {
+      out.holonomic_residual = 0;  // no nonholonomic row: the first kind by definition
+    } else if (hrows.empty()) {
+      out.holonomic_residual = maxAbs(Q);
+    } else {
+      MatX Ah(nv, hrows.size());
+      for (std::size_t k = 0; k < hrows.size(); ++k) Ah.col(k) = cd.A.row(hrows[k]).transpose();
+      Eigen::CompleteOrthogonalDecomposition<MatX> cod(Ah);
+      cod.setThreshold(1e-10);
+      const VecX lh = cod.solve(-Q);
+      out.holonomic_residual = maxAbs(Q + Ah * lh);
+    }
+    // A margin over the convergence tolerance: the held force is O(fs) when
+    // a nonholonomic row is needed, round-off when not.
+    out.second_kind = out.holonomic_residual > std::max(tol, 1e-8) * fs;
+  }
   out.reaction = m > 0 ? VecX(cd.A.transpose() * out.lambda) : VecX::Zero(nv);
   out.force_residual = maxAbs(Q + out.reaction);
   double g = 0;
@@ -298,6 +319,32 @@ MultiStartResult findEquilibria(const Model& model, const ConstraintList& constr
       }
     }
     if (!dup) out.distinct.push_back(static_cast<int>(k));
+  }
+  // Equilibrium sets: a distinct equilibrium joins the set of an earlier one
+  // when the straight path (in local coordinates) between them stays on
+  // equilibria. Only sets of positive dimension can hold two.
+  EquilibriumOptions walk = options;
+  walk.max_iterations = 20;
+  VecX q(model.nq);
+  for (std::size_t a = 0; a < out.distinct.size(); ++a) {
+    const EquilibriumResult& ra = out.runs[out.distinct[a]];
+    int set = -1;
+    for (std::size_t b = 0; b < a && set < 0; ++b) {
+      const EquilibriumResult& rb = out.runs[out.distinct[b]];
+      if (ra.manifold_dimension == 0 || rb.manifold_dimension == 0) continue;
+      difference(model, rb.q, ra.q, d);
+      const double length = d.norm();
+      bool on = true;
+      for (int k = 1; k < 8 && on; ++k) {
+        retract(model, rb.q, (k / 8.0) * d, q);
+        const EquilibriumResult e = findEquilibrium(model, constraints, q, walk);
+        VecX step(model.nv);
+        difference(model, q, e.q, step);
+        on = e.converged && step.norm() <= 1e-3 * length;
+      }
+      if (on) set = out.set[b];
+    }
+    out.set.push_back(set >= 0 ? set : out.sets++);
   }
   return out;
 }

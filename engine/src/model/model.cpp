@@ -206,8 +206,12 @@ Model ModelBuilder::build() const {
       case JointType::Revolute: case JointType::Continuous: j.S.col(0).head<3>() = j.axis; break;
       case JointType::Prismatic: j.S.col(0).tail<3>() = j.axis; break;
       case JointType::Planar: {
-        // Any orthonormal pair spanning the plane; t₁ × t₂ = axis.
-        j.t1 = j.axis.unitOrthogonal();
+        // A pair a user can guess (docs/engine.md): t₁ = the first of the
+        // joint frame's x, y axes not within 45° of the normal, projected
+        // into the plane; t₂ = axis × t₁. Axis z: (x, y); axis x: (y, z);
+        // axis y: (x, −z).
+        const Vec3 first = std::abs(j.axis.x()) < std::sqrt(0.5) ? Vec3::UnitX() : Vec3::UnitY();
+        j.t1 = (first - first.dot(j.axis) * j.axis).normalized();
         j.t2 = j.axis.cross(j.t1);
         j.S.col(0).tail<3>() = j.t1;
         j.S.col(1).tail<3>() = j.t2;
