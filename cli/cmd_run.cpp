@@ -89,6 +89,10 @@ void printContacts(std::ostream& out, const RunSummary& r) {
         out << " (no normal row)\n";
       continue;
     }
+    if (e.normal_held) {
+      out << " normal held by the joints (its row moves nothing: redundant by construction)\n";
+      continue;
+    }
     if (e.min_normal > e.max_normal) {  // no closed sample
       out << " open throughout (" << e.open_samples << " samples)\n";
       continue;

@@ -295,3 +295,23 @@ TEST(Cli, SleighOverItsBladeRestsOnTwoSetsOfTheSecondKind) {
   EXPECT_EQ(r.output.find("first kind"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("local dimension of the equilibrium set: 2"), std::string::npos) << r.output;
 }
+
+// A sleigh on a planar joint: the joint holds its height, so the blade's
+// normal row moves nothing (redundant by construction) and carries λ = 0.
+// That is not a normal that pulls: no "would lift off" warning, no flag.
+TEST(Cli, ANormalRowTheJointsHoldIsNotReportedAsPulling) {
+  const std::string path = ::testing::TempDir() + "planar_sleigh.urdf";
+  std::ofstream(path) << R"(<robot name="psleigh"><link name="world"/>
+  <link name="sleigh"><inertial><origin xyz="0.3 0 0"/><mass value="2"/>
+    <inertia ixx="0.08" ixy="0" ixz="0" iyy="0.12" iyz="0" izz="0.18"/></inertial></link>
+  <joint name="plane" type="planar"><parent link="world"/><child link="sleigh"/><axis xyz="0 0 1"/></joint>
+  <appell><gravity xyz="0 -1 -9.81"/><support name="ground" type="plane" normal="0 0 1" offset="0"/>
+    <contact name="blade" link="sleigh" kind="knife_edge" support="ground" point="0 0 0" direction="1 0 0"/>
+    <initial><joint name="plane" position="0 0 0" velocity="1 0 0.5"/></initial>
+    <simulation integrator="dopri5" duration="3"/></appell></robot>)";
+  const Result r = sh("run " + path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("blade                    normal held by the joints"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("would lift off"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("flagged"), std::string::npos) << r.output;
+}

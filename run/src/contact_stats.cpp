@@ -5,6 +5,9 @@
 // friction force.
 #include "contact_stats.hpp"
 
+#include <appell/constraint_set.hpp>
+#include <appell/kinematics.hpp>
+
 #include <cmath>
 
 namespace appell::run_detail {
@@ -31,6 +34,25 @@ std::vector<ContactStats> contactStats(const Scene& scene) {
   return stats;
 }
 
+void markHeldNormals(std::vector<ContactStats>& stats, const Scene& scene, const Simulator& sim) {
+  const Model& model = scene.model;
+  Data data(model, MassMatrix::None);
+  forwardKinematics(model, data, sim.q(), sim.v());
+  const ConstraintData& cd = sim.constraintData();
+  MatX J(6, model.nv), A;
+  VecX abias;
+  for (std::size_t k = 0; k < stats.size() && k < scene.constraints.size(); ++k) {
+    ContactStats& e = stats[k];
+    if (e.normal_row < 0) continue;
+    const Constraint& c = *scene.constraints[k];
+    A.resize(c.rows(), model.nv);
+    abias.resize(c.rows());
+    assembleConstraintRows(model, data, c, cd.blocks[k], J, A, abias);
+    const int r = e.normal_row - cd.offset[k];
+    e.normal_held = A.row(r).lpNorm<Eigen::Infinity>() <= 1e-12 * std::max(1.0, A.lpNorm<Eigen::Infinity>());
+  }
+}
+
 void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
             const ConstraintData& cdata) {
   for (ContactStats& e : stats) {
@@ -49,6 +71,7 @@ void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
     const double ft = std::sqrt(ft2);
     e.min_normal = std::min(e.min_normal, fn);
     e.max_normal = std::max(e.max_normal, fn);
+    if (e.normal_held) continue;  // the joints carry the normal: no load to judge
     if (fn <= 0) {  // a bilateral contact pulling, or a unilateral one at lift-off
       if (e.pulling++ == 0) e.first_pull = t;
       continue;

@@ -79,6 +79,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.options = options;
   s.passive = passiveScene(scene);
   s.contacts = run_detail::contactStats(scene);
+  run_detail::markHeldNormals(s.contacts, scene, sim);
   s.energy0 = sim.energy();
   s.energy_scale = std::max({std::abs(s.energy0), sim.kineticEnergy(), 1e-12});
   s.max_velocity_residual = sim.velocityResidual();

@@ -89,6 +89,9 @@ struct ContactStats {
   /// The friction demand exceeded μ or the normal pulled.
   bool flagged() const { return pulling > 0 || over_mu > 0; }
   long open_samples = 0;           ///< samples with the contact open (in flight)
+  /// The normal row moves nothing (the joints hold the contact's height, as a
+  /// planar joint does a sleigh's): no normal load or friction demand to judge.
+  bool normal_held = false;
   /// A one-row constraint that is not a contact (a mimic coupling): λ of its
   /// row, the generalized force it applies to its joint, and its range.
   int reaction_row = -1;
