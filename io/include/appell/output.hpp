@@ -8,8 +8,9 @@
 //                            floating  .x .y .z .qx .qy .qz .qw
 //                            ball      .qx .qy .qz .qw
 //   v:<joint>[.<coord>]    nv columns:
-//                            planar    .vx .vy .omega   (body frame)
-//                            floating  .wx .wy .wz .vx .vy .vz   (body frame)
+//                            planar    .vx .vy .omega   (link frame, along t₁ t₂)
+//                            floating  .wx .wy .wz .vx .vy .vz   (link frame; v of
+//                                      the link origin, not the centre of mass)
 //                            ball      .wx .wy .wz
 //   energy, residual
 //   per constraint c:  point:<c>.x .y .z,  normal:<c>.x .y .z,
