@@ -233,3 +233,27 @@ TEST(Run, ResidualWatchStopsDriftBeyondItsBound) {
   EXPECT_TRUE(off.ok) << off.failure;
   EXPECT_GT(std::max(off.max_velocity_residual, off.max_gap_residual), 1e-6);
 }
+
+// A billion N·m on one wheel of the car: no step can follow what that does,
+// and the run must say so — the failure names the joint force and its ratio
+// to the weight, not only the symptom (a step below h_min, or contact modes
+// that cycle on round-off). The same car with 1 N·m drives on unflagged.
+TEST(Run, AHugeJointForceIsNamedAsTheCauseOfTheFailure) {
+  std::ifstream in(std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf");
+  const std::string car((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto withEffort = [&](const std::string& value) {
+    std::string xml = car;
+    const std::string anchor = "<simulation";
+    xml.insert(xml.find(anchor), "<effort joint=\"front_left_joint\" value=\"" + value + "\"/>\n    ");
+    return loadSceneFromString(xml, std::string(APPELL_SOURCE_DIR) + "/examples/car", "car.urdf");
+  };
+  RunOptions o = runOptions(withEffort("1e9").settings);
+  o.duration = 0.01;
+  const RunSummary huge = runScene(withEffort("1e9"), o);
+  ASSERT_FALSE(huge.ok);
+  EXPECT_NE(huge.failure.find("the likely cause: the joint force on 'front_left_joint' is 1e+09"),
+            std::string::npos)
+      << huge.failure;
+  const RunSummary fine = runScene(withEffort("1"), o);
+  EXPECT_TRUE(fine.ok) << fine.failure;
+}

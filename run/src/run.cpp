@@ -35,6 +35,34 @@ bool passiveScene(const Scene& scene) {
   return true;
 }
 
+// A failed step names its symptom (a step size too small, contact modes that
+// cycle, constraints that disagree); when the joint forces dwarf the scene's
+// weight that is the cause to name: forces of that size spin or fling the
+// bodies faster than any step follows, and round-off in the reactions is
+// larger than the weight itself.
+std::string forceMagnitudeCause(const Scene& scene, const Simulator& sim) {
+  const Simulator::JointForces forces = scene.jointForces();
+  if (!forces) return "";
+  VecX tau = VecX::Zero(scene.model.nv);
+  forces(sim.time(), sim.q(), sim.v(), tau);
+  int at = 0;
+  const double largest = tau.cwiseAbs().maxCoeff(&at);
+  const double weight = scene.model.totalMass() * scene.model.gravity.norm();
+  const double scale = std::max(weight, 1.0);
+  if (!(largest > 1e4 * scale)) return "";
+  std::string joint;
+  for (int j = 0; j < scene.model.nbodies; ++j) {
+    const Joint& jt = scene.model.joints[j];
+    if (at >= jt.idx_v && at < jt.idx_v + jt.nv) joint = scene.model.joint_names[j];
+  }
+  std::ostringstream s;
+  s.precision(3);
+  s << "; the likely cause: the joint force on '" << joint << "' is " << largest << " (N or N·m), "
+    << largest / scale << " times the scene's weight of " << weight
+    << " N — forces of that size move the bodies faster than a step can follow";
+  return s.str();
+}
+
 }  // namespace
 
 int RunSummary::flaggedContacts() const {
@@ -91,7 +119,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.samples = 1;
   if (!sim.lastStateError().empty()) {
     s.ok = false;
-    s.failure = sim.lastStateError();
+    s.failure = sim.lastStateError() + forceMagnitudeCause(scene, sim);
     s.time = sim.time();
     s.counters = sim.counters();
     if (on_sample) on_sample(sim);
@@ -131,7 +159,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
     if (!status.ok) {
       s.ok = false;
-      s.failure = status.message;
+      s.failure = status.message + forceMagnitudeCause(scene, sim);
       break;
     }
     const double work_in = sim.jointWork() + sim.supportWork();

@@ -550,11 +550,18 @@ bool Simulator::forcePhase(std::string& error) {
     }
     u.vdot = u.res.vdot;
     forwardKinematics(model_, *data_, q_, v_, u.vdot);
+    // The tolerances scale with the forces at work: with 10⁹ N·m on a wheel,
+    // round-off in λ and γ̈ is far above 1e-9 and an absolute test would
+    // pivot on noise forever.
+    const double fscale = std::max({1.0, u.res.lambda.lpNorm<Eigen::Infinity>(),
+                                    tau_.lpNorm<Eigen::Infinity>()});
+    const double ascale = std::max(1.0, u.vdot.lpNorm<Eigen::Infinity>());
     int flip = -1;
     for (int k = 0; k < static_cast<int>(u.rows.size()) && flip < 0; ++k) {
       const auto& r = u.rows[k];
       if (!r.touching) continue;
-      if (r.in_set ? u.res.lambda[r.global] < -o.force_tol : rowAcceleration(k) < -acc_tol)
+      if (r.in_set ? u.res.lambda[r.global] < -o.force_tol * fscale
+                   : rowAcceleration(k) < -acc_tol * ascale)
         flip = k;
     }
     if (flip < 0) break;
