@@ -188,6 +188,18 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
   out << (events ? "\n" : "none\n");
   printEvents(out, r);
   printContacts(out, r);
+  if (!r.actuators.empty()) {
+    out << "actuators (over " << r.samples << " samples):\n";
+    for (const RunSummary::ActuatorStats& a : r.actuators) {
+      out << "  " << std::left << std::setw(24) << a.name << std::right << std::setprecision(4)
+          << " |τ| up to " << a.max_force;
+      if (std::isfinite(a.effort_limit)) out << " of " << a.effort_limit;
+      if (a.saturated)
+        out << ", saturated in " << a.saturated << " samples (t = " << a.first_saturated << " … "
+            << a.last_saturated << ")";
+      out << "\n";
+    }
+  }
 }
 
 }  // namespace

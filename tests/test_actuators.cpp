@@ -119,6 +119,13 @@ TEST(Actuators, VelocityServoSaturatesAtTheUrdfEffortLimit) {
   const RunSummary r = runScene(s, tight(30));
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_FALSE(r.passive);
+  // The summary: the servo applied its limit, saturated from t = 0 to the
+  // last sample before t_sat (samples are the steps, at most duration/20 apart).
+  ASSERT_EQ(r.actuators.size(), 1u);
+  EXPECT_EQ(r.actuators[0].max_force, tau_max);
+  EXPECT_EQ(r.actuators[0].first_saturated, 0);
+  EXPECT_LE(r.actuators[0].last_saturated, t_sat);
+  EXPECT_GT(r.actuators[0].last_saturated, t_sat - 30.0 / 20);
   // ΔE = ∫ τ ω dt, the integral by the trapezoidal rule over the steps.
   EXPECT_LT(r.relativeEnergyDeviation(), 1e-5);
 }

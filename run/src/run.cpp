@@ -63,6 +63,20 @@ std::string forceMagnitudeCause(const Scene& scene, const Simulator& sim) {
   return s.str();
 }
 
+void sampleActuators(RunSummary& s, const Scene& scene, const Simulator& sim) {
+  for (std::size_t k = 0; k < scene.actuators.size(); ++k) {
+    const Actuator& a = scene.actuators[k];
+    const Joint& j = scene.model.joints[a.joint];
+    const double demand = a.demand(sim.time(), sim.q()[j.idx_q], sim.v()[j.idx_v]);
+    RunSummary::ActuatorStats& st = s.actuators[k];
+    st.max_force = std::max(st.max_force, std::min(std::abs(demand), a.effort_limit));
+    if (std::abs(demand) > a.effort_limit) {
+      if (st.saturated++ == 0) st.first_saturated = sim.time();
+      st.last_saturated = sim.time();
+    }
+  }
+}
+
 }  // namespace
 
 int RunSummary::flaggedContacts() const {
@@ -108,6 +122,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.passive = passiveScene(scene);
   s.contacts = run_detail::contactStats(scene);
   run_detail::markHeldNormals(s.contacts, scene, sim);
+  for (const Actuator& a : scene.actuators) s.actuators.push_back({a.name, 0, a.effort_limit, 0, -1, -1});
   s.energy0 = sim.energy();
   s.energy_scale = std::max({std::abs(s.energy0), sim.kineticEnergy(), 1e-12});
   s.max_velocity_residual = sim.velocityResidual();
@@ -116,6 +131,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.free_velocities =
       scene.model.nv - (sim.constraintData().m_active - sim.redundantRows());
   run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
+  sampleActuators(s, scene, sim);
   s.samples = 1;
   if (!sim.lastStateError().empty()) {
     s.ok = false;
@@ -216,6 +232,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     s.max_gap_residual = std::max(s.max_gap_residual, sim.gapResidual());
     s.max_redundant = std::max(s.max_redundant, sim.redundantRows());
     run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
+    sampleActuators(s, scene, sim);
+  sampleActuators(s, scene, sim);
     ++s.samples;
     // A step that ends at an event is always a sample: each event is a row.
     const bool sampled = step % options.output_every == 0 || !sim.events().empty();

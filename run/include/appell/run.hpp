@@ -137,6 +137,15 @@ struct RunSummary {
   int free_velocities = 0;
   long samples = 0;                ///< states summarised (t = 0 and every step)
   std::vector<ContactStats> contacts;  ///< one per constraint, in order
+  /// One per actuator (Scene::actuators), over the samples: the largest
+  /// |τ| it applied and how often it was saturated at its effort limit.
+  struct ActuatorStats {
+    std::string name;
+    double max_force = 0, effort_limit = 0;
+    long saturated = 0;
+    double first_saturated = -1, last_saturated = -1;
+  };
+  std::vector<ActuatorStats> actuators;
 
   double relativeEnergyDeviation() const { return max_energy_deviation / energy_scale; }
   int flaggedContacts() const;
