@@ -6,7 +6,12 @@
 #include <assimp/scene.h>
 #include <assimp/config.h>
 
+#include <algorithm>
 #include <array>
+#include <cctype>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -14,11 +19,56 @@
 
 namespace appell {
 
+namespace {
+
+// Collada's numeric lists (<p>, <v>, <vcount>, <float_array>, <int_array>)
+// must hold numbers only. assimp 5.2.5 reads a corrupted index list (a
+// stray non-ASCII byte inside a <p>) as an index of billions and allocates
+// gigabytes for it — found by the mesh fuzzer
+// (tests/data/fuzz-regressions/assimp_dae_index_oom.dae) — so the lists are
+// checked before assimp sees the file, and the first bad one is named.
+void checkColladaNumbers(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  static const char* kLists[] = {"<p>", "<p ", "<v>", "<v ", "<vcount", "<float_array", "<int_array"};
+  for (const char* tag : kLists) {
+    for (std::size_t at = text.find(tag); at != std::string::npos; at = text.find(tag, at + 1)) {
+      const std::size_t open_end = text.find('>', at);
+      if (open_end == std::string::npos || text[open_end - 1] == '/') continue;
+      const std::size_t close = text.find('<', open_end + 1);
+      if (close == std::string::npos) break;
+      for (std::size_t k = open_end + 1; k < close; ++k) {
+        const unsigned char c = static_cast<unsigned char>(text[k]);
+        if (std::isdigit(c) || std::isspace(c) || c == '.' || c == '-' || c == '+' || c == 'e' ||
+            c == 'E')
+          continue;
+        const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(k), '\n');
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02x", c);
+        std::string name(tag + 1);
+        if (name.back() == ' ' || name.back() == '>') name.pop_back();
+        throw SceneError(path + ":" + std::to_string(line) + ": <" + name +
+                         ">: a Collada number list holds byte " + hex + " (not a number): the file is damaged");
+      }
+      at = close;
+    }
+  }
+}
+
+bool hasExtension(const std::string& path, const char* ext) {
+  std::string e = std::filesystem::path(path).extension().string();
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e == ext;
+}
+
+}  // namespace
+
 TriangleMesh loadMesh(const std::string& path, const Vec3& scale) {
   if (!std::filesystem::is_regular_file(path))
     throw SceneError(path + ": mesh file not found");
   if (!scale.allFinite() || scale.cwiseAbs().minCoeff() == 0)
     throw SceneError(path + ": mesh scale must be finite and non-zero");
+  if (hasExtension(path, ".dae")) checkColladaNumbers(path);
   Assimp::Importer importer;
   // ROS tools take a Collada file's coordinates as they are (URDF frames are
   // z-up); assimp would otherwise rotate Z_UP files into its own y-up frame.
