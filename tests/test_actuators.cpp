@@ -8,6 +8,8 @@
 #include <appell/run.hpp>
 #include <appell/urdf.hpp>
 
+#include "scene_helpers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -28,23 +30,9 @@ std::string rotor(const std::string& actuator, const std::string& limit = "") {
 <appell>)" + actuator + R"(</appell></robot>)";
 }
 
-std::string loadError(const std::string& xml) {
-  try {
-    loadSceneFromString(xml, ".", "servo.urdf");
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "(loaded)";
-}
+std::string loadError(const std::string& xml) { return test::loadMessage(xml, "servo.urdf"); }
 
-RunOptions tight(double duration) {
-  RunOptions o;
-  o.integrator = IntegratorType::DormandPrince54;
-  o.tol = 1e-12;
-  o.dt = 1e-3;
-  o.duration = duration;
-  return o;
-}
+RunOptions tight(double duration) { return test::tightRun(duration); }
 
 }  // namespace
 

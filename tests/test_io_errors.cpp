@@ -3,6 +3,8 @@
 // partial scene.
 #include <appell/urdf.hpp>
 
+#include "scene_helpers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -42,14 +44,8 @@ void expectError(const std::string& file, int line, const std::vector<std::strin
     EXPECT_NE(msg.find(p), std::string::npos) << "missing \"" << p << "\" in:\n  " << msg;
 }
 
-// Loads the text `xml` named `name`: the SceneError message, or "(loaded)".
 std::string messageOf(const std::string& xml, const std::string& name) {
-  try {
-    loadSceneFromString(xml, ".", name);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "(loaded)";
+  return test::loadMessage(xml, name);
 }
 
 }  // namespace

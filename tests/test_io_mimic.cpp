@@ -7,6 +7,8 @@
 #include <appell/run.hpp>
 #include <appell/urdf.hpp>
 
+#include "scene_helpers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -44,22 +46,10 @@ std::string gripper(const std::string& mimic, const std::string& initial = "",
 const std::string kGripperMimic = R"(<mimic joint="left_joint" multiplier="-1" offset="0.02"/>)";
 
 std::string loadError(const std::string& xml, const LoadOptions& options = {}) {
-  try {
-    loadSceneFromString(xml, ".", "mimic.urdf", options);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "(loaded)";
+  return test::loadMessage(xml, "mimic.urdf", options);
 }
 
-RunOptions tight(Formulation f) {
-  RunOptions o;
-  o.integrator = IntegratorType::DormandPrince54;
-  o.tol = 1e-12;
-  o.dt = 1e-3;
-  o.formulation = f;
-  return o;
-}
+RunOptions tight(Formulation f) { return test::tightRun(1.0, f); }
 
 }  // namespace
 
