@@ -21,34 +21,67 @@ namespace appell {
 
 namespace {
 
-// Collada's numeric lists (<p>, <v>, <vcount>, <float_array>, <int_array>)
-// must hold numbers only. assimp 5.2.5 reads a corrupted index list (a
-// stray non-ASCII byte inside a <p>) as an index of billions and allocates
-// gigabytes for it — found by the mesh fuzzer
-// (tests/data/fuzz-regressions/assimp_dae_index_oom.dae) — so the lists are
+// Collada's number lists must hold numbers only: indices (<p>, <v>,
+// <vcount>, <int_array>) unsigned integers no larger than the file could
+// hold values for, coordinates (<float_array>) decimal numbers. assimp 5.2.5
+// reads a corrupted index list — a stray byte, or coordinates pasted into a
+// <p> — as indices of billions and allocates gigabytes for them (13 GB and
+// 40 s before std::bad_alloc), found by the mesh fuzzer
+// (tests/data/fuzz-regressions/assimp_dae_*_oom.dae). So the lists are
 // checked before assimp sees the file, and the first bad one is named.
 void checkColladaNumbers(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  static const char* kLists[] = {"<p>", "<p ", "<v>", "<v ", "<vcount", "<float_array", "<int_array"};
-  for (const char* tag : kLists) {
-    for (std::size_t at = text.find(tag); at != std::string::npos; at = text.find(tag, at + 1)) {
+  // Every count="N" (arrays, accessors, primitives): assimp reserves N.
+  for (std::size_t at = text.find("count=\""); at != std::string::npos; at = text.find("count=\"", at + 1)) {
+    std::size_t value = 0, k = at + 7;
+    for (; k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])); ++k) {
+      value = value * 10 + static_cast<std::size_t>(text[k] - '0');
+      if (value > text.size()) {
+        const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
+        throw SceneError(path + ":" + std::to_string(line) + ": count=\"" + text.substr(at + 7, k - at - 6) +
+                         "…\": more values than the file could hold: the file is damaged");
+      }
+    }
+  }
+  struct List {
+    const char* tag;
+    bool indices;
+  };
+  static const List kLists[] = {{"<p>", true},       {"<p ", true},          {"<v>", true},
+                                {"<v ", true},       {"<vcount", true},      {"<int_array", true},
+                                {"<float_array", false}};
+  for (const List& list : kLists) {
+    for (std::size_t at = text.find(list.tag); at != std::string::npos; at = text.find(list.tag, at + 1)) {
       const std::size_t open_end = text.find('>', at);
       if (open_end == std::string::npos || text[open_end - 1] == '/') continue;
       const std::size_t close = text.find('<', open_end + 1);
       if (close == std::string::npos) break;
+      std::string name(list.tag + 1);
+      if (name.back() == ' ' || name.back() == '>') name.pop_back();
+      auto bad = [&](std::size_t k, const std::string& why) {
+        const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(k), '\n');
+        throw SceneError(path + ":" + std::to_string(line) + ": <" + name + ">: " + why +
+                         ": the file is damaged");
+      };
+      std::size_t value = 0;
       for (std::size_t k = open_end + 1; k < close; ++k) {
         const unsigned char c = static_cast<unsigned char>(text[k]);
-        if (std::isdigit(c) || std::isspace(c) || c == '.' || c == '-' || c == '+' || c == 'e' ||
-            c == 'E')
+        if (std::isspace(c)) {
+          value = 0;
           continue;
-        const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(k), '\n');
-        char hex[8];
-        std::snprintf(hex, sizeof hex, "0x%02x", c);
-        std::string name(tag + 1);
-        if (name.back() == ' ' || name.back() == '>') name.pop_back();
-        throw SceneError(path + ":" + std::to_string(line) + ": <" + name +
-                         ">: a Collada number list holds byte " + hex + " (not a number): the file is damaged");
+        }
+        const bool ok = std::isdigit(c) || (!list.indices && (c == '.' || c == '-' || c == '+' || c == 'e' || c == 'E'));
+        if (!ok) {
+          char shown[8];
+          std::snprintf(shown, sizeof shown, std::isprint(c) ? "'%c'" : "0x%02x", c);
+          bad(k, std::string(list.indices ? "an index" : "a number") + " list holds " + shown);
+        }
+        if (list.indices) {
+          value = value * 10 + static_cast<std::size_t>(c - '0');
+          if (value > text.size())
+            bad(k, "an index or count larger than the file could hold values for");
+        }
       }
       at = close;
     }
