@@ -73,6 +73,7 @@ TEST(FuzzRegressions, DamagedColladaNumberListsAreRefusedBeforeAssimpReadsThem) 
   refused(p, "<p>98765432109876 " + p.substr(3), "<p>: an index or count larger than the file could hold");
   refused("count=\"3270\"", "count=\"3270000000\"", "more values than the file could hold");
   refused("0.0796148", "0.07x6148", "<float_array>: a number list holds 'x'");
+  refused("array\" count=\"3270\"", "array\" mater=\"3270\"", "<float_array>: has no count attribute");
   // The undamaged file loads.
   EXPECT_EQ(loadMesh((fs::path(APPELL_SOURCE_DIR) / "examples/diff_drive/meshes/wheel.dae").string()).triangles.size(), 2176u);
 }

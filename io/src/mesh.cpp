@@ -10,6 +10,7 @@
 #include <array>
 #include <cctype>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <filesystem>
@@ -27,8 +28,8 @@ namespace {
 // reads a corrupted index list — a stray byte, or coordinates pasted into a
 // <p> — as indices of billions and allocates gigabytes for them (13 GB and
 // 40 s before std::bad_alloc), found by the mesh fuzzer
-// (tests/data/fuzz-regressions/assimp_dae_*_oom.dae). So the lists are
-// checked before assimp sees the file, and the first bad one is named.
+// (tests/data/fuzz-regressions/assimp_dae_*). So the lists are checked
+// before assimp sees the file, and the first bad one is named.
 void checkColladaNumbers(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -41,6 +42,24 @@ void checkColladaNumbers(const std::string& path) {
         const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
         throw SceneError(path + ":" + std::to_string(line) + ": count=\"" + text.substr(at + 7, k - at - 6) +
                          "…\": more values than the file could hold: the file is damaged");
+      }
+    }
+  }
+  // Arrays, accessors and primitives must say how many values they hold
+  // (assimp 5.2.5 dereferences a missing count: a segfault the fuzzer found).
+  for (const char* tag : {"<float_array", "<int_array", "<accessor", "<triangles", "<polylist",
+                          "<polygons", "<lines", "<linestrips", "<trifans", "<tristrips"}) {
+    const std::size_t len = std::strlen(tag);
+    for (std::size_t at = text.find(tag); at != std::string::npos; at = text.find(tag, at + 1)) {
+      const char after = at + len < text.size() ? text[at + len] : '>';
+      if (!std::isspace(static_cast<unsigned char>(after)) && after != '>' && after != '/') continue;
+      const std::size_t open_end = text.find('>', at);
+      const std::string open = text.substr(at, open_end == std::string::npos ? std::string::npos : open_end - at);
+      if (open.find(" count=\"") == std::string::npos && open.find("\tcount=\"") == std::string::npos &&
+          open.find("\ncount=\"") == std::string::npos) {
+        const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
+        throw SceneError(path + ":" + std::to_string(line) + ": " + std::string(tag) +
+                         ">: has no count attribute (Collada requires it): the file is damaged");
       }
     }
   }
