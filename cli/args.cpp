@@ -28,10 +28,17 @@ Args::Args(int argc, char** argv, int first, const std::set<std::string>& valued
         value = argv[++i];
       }
       values_[name] = value;
+      repeated_[name].push_back(value);
     } else {
       throw UsageError("unknown option --" + name);
     }
   }
+}
+
+const std::vector<std::string>& Args::all(const std::string& name) const {
+  static const std::vector<std::string> none;
+  auto it = repeated_.find(name);
+  return it == repeated_.end() ? none : it->second;
 }
 
 std::string Args::text(const std::string& name, const std::string& fallback) const {

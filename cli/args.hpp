@@ -28,10 +28,13 @@ class Args {
   int integer(const std::string& name, int fallback) const;
   /// Comma-separated list.
   std::vector<std::string> list(const std::string& name) const;
+  /// Every value of an option given more than once (--set a=1 --set b=2), in order.
+  const std::vector<std::string>& all(const std::string& name) const;
 
  private:
   std::vector<std::string> positional_;
-  std::map<std::string, std::string> values_;
+  std::map<std::string, std::string> values_;  ///< the last value of each option
+  std::map<std::string, std::vector<std::string>> repeated_;
 };
 
 }  // namespace appell::cli

@@ -1,16 +1,21 @@
 // appell linearize: eigenvalues of the constrained dynamics about an
-// equilibrium or a steady motion, in independent coordinates.
+// equilibrium or a steady motion, in independent coordinates — once, or over
+// a sweep of a parameter (the stability diagram).
 #include "commands.hpp"
-
-#include <appell/output.hpp>
+#include "overrides.hpp"
+#include "plot.hpp"
 
 #include <appell/appell.hpp>
 #include <appell/equilibria.hpp>
 #include <appell/linearization.hpp>
+#include <appell/output.hpp>
 
 #include <algorithm>
+#include <complex>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <thread>
 
 namespace appell::cli {
 
@@ -31,21 +36,36 @@ scene's initial state and prints the eigenvalues.
   --formulation F     {formulations} (default: the scene's)
   --zero-tol TOL      |μ| below TOL × max(1, max |μ|) counts as zero, and a real
                       part below it is not growth (default 1e-4)
+  --fd-step H         finite-difference step in the local coordinates (default 1e-5)
+  --set NAME=VALUE    override before linearizing (repeatable): gravity=gx,gy,gz,
+                      speed=V (a floating base's forward speed, the other velocities
+                      completed by the constraints), <joint>.position=…,
+                      <joint>.velocity=…, or a coordinate by its CSV name
+  --sweep NAME=START:STOP:COUNT
+                      linearize at COUNT values of a one-number override, on all
+                      cores; prints the largest real part per value and the values
+                      where stability changes
+  --format F          text (default), csv or json — full precision
+  --plot FILE.png     with --sweep: the stability diagram (largest real part
+                      against the swept parameter), drawn by gnuplot
 
 Exit status 3 when the reference is not an equilibrium / steady motion.
   --package-path DIRS
 )";
 
-}  // namespace
+struct Analysis {
+  bool ok = false;             ///< a verdict: the reference is an equilibrium / steady motion
+  std::string message;         ///< why not, when !ok
+  LinearizationResult result;
+  std::vector<std::complex<double>> eigenvalues;  ///< largest real part first
+  double tol = 0, max_real = 0;
+  int zeros = 0;
+};
 
-int linearize(int argc, char** argv) {
-  Args args(argc, argv, 2, {"cyclic", "formulation", "zero-tol", "package-path"},
-            {"help", "equilibrium", "project-initial", "no-joint-limits"});
-  if (args.has("help")) {
-    std::cout << helpText(kHelp);
-    return 0;
-  }
-  const Scene scene = loadFromArgs(args, !args.has("equilibrium"));
+// One linearization of `scene` as the options say.
+Analysis analyse(const Scene& scene, const Args& args, const std::vector<int>& cyclic, Formulation form,
+                 bool print) {
+  Analysis a;
   const Model& m = scene.model;
   VecX q = scene.q0, v = scene.v0;
   if (args.has("equilibrium")) {
@@ -53,25 +73,223 @@ int linearize(int argc, char** argv) {
     if (scene.tau.size() == m.nv) eo.tau = scene.tau;
     const EquilibriumResult e = findEquilibrium(m, scene.constraints, scene.q0, eo);
     if (!e.converged) {
-      std::cout << e.message << "\n";
-      return 3;
+      a.message = e.message;
+      return a;
     }
     q = e.q;
     v.setZero();
-    std::cout << "equilibrium found (residual " << e.residual << ", local dimension "
-              << e.manifold_dimension << ")\n";
+    if (print)
+      std::cout << "equilibrium found (residual " << e.residual << ", local dimension "
+                << e.manifold_dimension << ")\n";
   }
   LinearizationOptions lo;
   if (scene.tau.size() == m.nv) lo.tau = scene.tau;
+  lo.cyclic = cyclic;
+  lo.fd_step = args.positiveNumber("fd-step", lo.fd_step);
+  auto solver = makeSolver(form, m, scene.constraints);
+  a.result = linearize(m, scene.constraints, *solver, q, v, lo);
+  const LinearizationResult& r = a.result;
+  a.eigenvalues.assign(r.eigenvalues.data(), r.eigenvalues.data() + r.eigenvalues.size());
+  std::sort(a.eigenvalues.begin(), a.eigenvalues.end(), [](auto x, auto y) {
+    return x.real() != y.real() ? x.real() > y.real() : x.imag() > y.imag();
+  });
+  // Relative to the eigenvalues' scale: round-off in a fast system's
+  // eigenvalues is larger than 1e-4 in absolute terms, and is not instability.
+  double scale = 1.0;
+  for (const auto& z : a.eigenvalues) scale = std::max(scale, std::abs(z));
+  a.tol = args.positiveNumber("zero-tol", 1e-4) * scale;
+  a.zeros = countZeroEigenvalues(r, a.tol);
+  a.max_real = a.eigenvalues.empty() ? 0.0 : a.eigenvalues.front().real();
+  if (r.steady_residual > 1e-6 * scale || r.constraint_residual > 1e-8) {
+    std::ostringstream s;
+    s << "the reference state is not an equilibrium or steady motion (steady residual "
+      << r.steady_residual << ")";
+    a.message = s.str();
+    return a;
+  }
+  a.ok = true;
+  return a;
+}
+
+std::string full(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+int printOne(const Scene& scene, const Analysis& a, const std::vector<int>& cyclic, const std::string& format) {
+  const LinearizationResult& r = a.result;
+  if (format == "json") {
+    std::cout << "{\"scene\": \"" << scene.source << "\", \"dimension\": " << r.dimension
+              << ", \"constraint_residual\": " << full(r.constraint_residual)
+              << ", \"steady_residual\": " << full(r.steady_residual) << ", \"eigenvalues\": [";
+    for (std::size_t k = 0; k < a.eigenvalues.size(); ++k)
+      std::cout << (k ? ", " : "") << "[" << full(a.eigenvalues[k].real()) << ", " << full(a.eigenvalues[k].imag()) << "]";
+    std::cout << "], \"zero_eigenvalues\": " << a.zeros << ", \"max_real\": " << full(a.max_real)
+              << ", \"verdict\": \"" << (!a.ok ? "none" : a.max_real > a.tol ? "unstable" : "not growing") << "\"}\n";
+    return a.ok ? 0 : 3;
+  }
+  if (format == "csv") {
+    std::cout << "real,imag\n";
+    for (const auto& z : a.eigenvalues) std::cout << full(z.real()) << "," << full(z.imag()) << "\n";
+    return a.ok ? 0 : 3;
+  }
+  std::cout << "scene " << scene.source << "\n"
+            << "reduced state dimension " << r.dimension << " (tangent space of the constraint manifold)\n"
+            << "reference: constraint residual " << r.constraint_residual << ", steady residual "
+            << r.steady_residual;
+  if (!cyclic.empty()) std::cout << ", symmetry residual " << r.symmetry_residual;
+  std::cout << "\neigenvalues (real, imag):\n" << std::setprecision(8);
+  for (const auto& z : a.eigenvalues)
+    std::cout << "  " << std::setw(16) << z.real() << "  " << std::setw(16) << z.imag() << "\n";
+  std::cout << a.zeros << " zero eigenvalues (|μ| < " << a.tol << " = zero-tol × max(1, max |μ|))\n";
+  if (!a.ok) {
+    std::cout << "no stability verdict: " << a.message << "; try --equilibrium or --cyclic\n";
+    return 3;
+  }
+  std::cout << (a.max_real > a.tol ? "unstable: largest real part " + std::to_string(a.max_real)
+                                   : std::string("no exponentially growing mode (to within the zero tolerance)"))
+            << "\n";
+  return 0;
+}
+
+int sweep(const Scene& base, const std::vector<int>& kept_base, const Args& args,
+          const std::vector<int>& cyclic, Formulation form, const std::string& format) {
+  const Sweep sw = parseSweep(args.text("sweep"));
+  std::vector<Analysis> out(sw.values.size());
+  std::vector<std::string> errors(sw.values.size());
+  // One value per task, on every core; each task its own scene copy and solver.
+  const unsigned workers = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(),
+                                                           static_cast<unsigned>(sw.values.size())));
+  std::vector<std::thread> pool;
+  for (unsigned w = 0; w < workers; ++w)
+    pool.emplace_back([&, w] {
+      for (std::size_t k = w; k < sw.values.size(); k += workers) {
+        try {
+          Scene s = base;
+          std::vector<int> kept = kept_base;
+          applyOverride(s, sw.name, full(sw.values[k]), kept);
+          completeVelocities(s, kept);
+          out[k] = analyse(s, args, cyclic, form, false);
+        } catch (const std::exception& e) {
+          errors[k] = e.what();
+        }
+      }
+    });
+  for (std::thread& t : pool) t.join();
+  for (std::size_t k = 0; k < errors.size(); ++k)
+    if (!errors[k].empty()) throw UsageError(sw.name + "=" + full(sw.values[k]) + ": " + errors[k]);
+
+  // Where the verdict changes between neighbours, found by bisection to
+  // 1e-9 relative: the largest real part vanishes like a square root at a
+  // threshold (a real pair becoming imaginary), so interpolating it would be
+  // off by a good part of the step.
+  auto unstable = [&](double value) {
+    Scene s = base;
+    std::vector<int> kept = kept_base;
+    applyOverride(s, sw.name, full(value), kept);
+    completeVelocities(s, kept);
+    const Analysis a = analyse(s, args, cyclic, form, false);
+    return std::pair<bool, bool>(a.ok, a.max_real > a.tol);
+  };
+  std::vector<double> changes;
+  for (std::size_t k = 1; k < out.size(); ++k) {
+    const Analysis &a = out[k - 1], &b = out[k];
+    if (!a.ok || !b.ok || (a.max_real > a.tol) == (b.max_real > b.tol)) continue;
+    double lo = sw.values[k - 1], hi = sw.values[k];
+    const bool lo_unstable = a.max_real > a.tol;
+    for (int it = 0; it < 60 && std::abs(hi - lo) > 1e-9 * std::max(1.0, std::abs(lo)); ++it) {
+      const double mid = 0.5 * (lo + hi);
+      const auto [ok, u] = unstable(mid);
+      if (!ok) break;
+      (u == lo_unstable ? lo : hi) = mid;
+    }
+    changes.push_back(0.5 * (lo + hi));
+  }
+  if (format == "json") {
+    std::cout << "{\"scene\": \"" << base.source << "\", \"parameter\": \"" << sw.name << "\", \"results\": [";
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const Analysis& a = out[k];
+      std::cout << (k ? ",\n  " : "\n  ") << "{\"value\": " << full(sw.values[k]) << ", \"verdict\": \""
+                << (!a.ok ? "none" : a.max_real > a.tol ? "unstable" : "not growing")
+                << "\", \"max_real\": " << full(a.max_real) << ", \"eigenvalues\": [";
+      for (std::size_t i = 0; i < a.eigenvalues.size(); ++i)
+        std::cout << (i ? ", " : "") << "[" << full(a.eigenvalues[i].real()) << ", " << full(a.eigenvalues[i].imag()) << "]";
+      std::cout << "]}";
+    }
+    std::cout << "],\n \"stability_changes\": [";
+    for (std::size_t k = 0; k < changes.size(); ++k) std::cout << (k ? ", " : "") << full(changes[k]);
+    std::cout << "]}\n";
+  } else if (format == "csv") {
+    std::cout << sw.name << ",verdict,max_real";
+    std::size_t n = 0;
+    for (const Analysis& a : out) n = std::max(n, a.eigenvalues.size());
+    for (std::size_t i = 0; i < n; ++i) std::cout << ",re" << i << ",im" << i;
+    std::cout << "\n";
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const Analysis& a = out[k];
+      std::cout << full(sw.values[k]) << "," << (!a.ok ? "none" : a.max_real > a.tol ? "unstable" : "stable")
+                << "," << full(a.max_real);
+      for (std::size_t i = 0; i < n; ++i)
+        if (i < a.eigenvalues.size()) std::cout << "," << full(a.eigenvalues[i].real()) << "," << full(a.eigenvalues[i].imag());
+        else std::cout << ",,";
+      std::cout << "\n";
+    }
+  } else {
+    std::cout << "scene " << base.source << ": " << out.size() << " values of " << sw.name << " on "
+              << workers << " threads\n"
+              << std::setw(16) << sw.name << std::setw(18) << "largest Re" << "  verdict\n";
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const Analysis& a = out[k];
+      std::cout << std::setprecision(8) << std::setw(16) << sw.values[k] << std::setw(18) << a.max_real << "  "
+                << (!a.ok ? "no verdict: " + a.message : a.max_real > a.tol ? "unstable" : "no growing mode") << "\n";
+    }
+    if (changes.empty()) std::cout << "stability does not change over the sweep\n";
+    for (double c : changes) std::cout << "stability changes at " << sw.name << " ≈ " << std::setprecision(10) << c << "\n";
+  }
+  if (args.has("plot")) {
+    std::vector<double> x, y;
+    for (std::size_t k = 0; k < out.size(); ++k)
+      if (out[k].ok) {
+        x.push_back(sw.values[k]);
+        y.push_back(out[k].max_real);
+      }
+    writeStabilityPlot(args.text("plot"), sw.name, x, y);
+    if (format == "text") std::cout << "stability diagram " << args.text("plot") << "\n";
+  }
+  return std::any_of(out.begin(), out.end(), [](const Analysis& a) { return a.ok; }) ? 0 : 3;
+}
+
+}  // namespace
+
+int linearize(int argc, char** argv) {
+  Args args(argc, argv, 2,
+            {"cyclic", "formulation", "zero-tol", "package-path", "fd-step", "set", "sweep", "format", "plot"},
+            {"help", "equilibrium", "project-initial", "no-joint-limits"});
+  if (args.has("help")) {
+    std::cout << helpText(kHelp);
+    return 0;
+  }
+  const std::string format = args.text("format", "text");
+  if (format != "text" && format != "csv" && format != "json")
+    throw UsageError("--format must be text, csv or json, not '" + format + "'");
+  if (args.has("plot") && !args.has("sweep")) throw UsageError("--plot draws a --sweep's stability diagram");
+  // Overrides change the state: check it after them, not at load.
+  const bool overrides = !args.all("set").empty();
+  Scene scene = loadFromArgs(args, !args.has("equilibrium") && !overrides);
+  const std::vector<int> kept = applyOverrides(scene, args);
+  if (overrides && !args.has("equilibrium"))
+    checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
+  std::vector<int> cyclic;
   for (const std::string& c : args.list("cyclic")) {
     int k;
     try {
-      k = localCoordinateIndex(m, c);
+      k = localCoordinateIndex(scene.model, c);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--cyclic: ") + e.what());
     }
     if (k < 0) throw UsageError("--cyclic: no coordinate named '" + c + "' (names as the CSV's q: and v: columns)");
-    lo.cyclic.push_back(k);
+    cyclic.push_back(k);
   }
   Formulation form;
   try {
@@ -79,41 +297,13 @@ int linearize(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  auto solver = makeSolver(form, m, scene.constraints);
-  const LinearizationResult r = linearize(m, scene.constraints, *solver, q, v, lo);
-  // Finite differences split a zero Jordan block by ~√(round-off): 1e-4 absorbs that.
-  const double zero_tol = args.positiveNumber("zero-tol", 1e-4);
-
-  std::vector<std::complex<double>> ev(r.eigenvalues.data(), r.eigenvalues.data() + r.eigenvalues.size());
-  std::sort(ev.begin(), ev.end(), [](auto a, auto b) {
-    return a.real() != b.real() ? a.real() > b.real() : a.imag() > b.imag();
-  });
-  std::cout << "scene " << scene.source << "\n"
-            << "reduced state dimension " << r.dimension << " (tangent space of the constraint manifold)\n"
-            << "reference: constraint residual " << r.constraint_residual << ", steady residual "
-            << r.steady_residual;
-  if (!lo.cyclic.empty()) std::cout << ", symmetry residual " << r.symmetry_residual;
-  std::cout << "\neigenvalues (real, imag):\n" << std::setprecision(8);
-  for (const auto& z : ev)
-    std::cout << "  " << std::setw(16) << z.real() << "  " << std::setw(16) << z.imag() << "\n";
-  // Relative to the eigenvalues' scale: round-off in a fast system's
-  // eigenvalues is larger than 1e-4 in absolute terms, and is not instability.
-  double scale = 1.0;
-  for (const auto& z : ev) scale = std::max(scale, std::abs(z));
-  const double tol = zero_tol * scale;
-  const int zeros = countZeroEigenvalues(r, tol);
-  const double max_re = ev.empty() ? 0.0 : ev.front().real();
-  std::cout << zeros << " zero eigenvalues (|μ| < " << tol << " = zero-tol × max(1, max |μ|))\n";
-  // A verdict needs a true equilibrium / steady motion; otherwise say why not.
-  if (r.steady_residual > 1e-6 * scale || r.constraint_residual > 1e-8) {
-    std::cout << "no stability verdict: the reference state is not an equilibrium or steady motion"
-              << " (steady residual " << r.steady_residual << "); try --equilibrium or --cyclic\n";
+  if (args.has("sweep")) return sweep(scene, kept, args, cyclic, form, format);
+  const Analysis a = analyse(scene, args, cyclic, form, format == "text");
+  if (!a.ok && a.message.rfind("the reference", 0) != 0) {  // no equilibrium found
+    std::cout << a.message << "\n";
     return 3;
   }
-  std::cout << (max_re > tol ? "unstable: largest real part " + std::to_string(max_re)
-                                  : std::string("no exponentially growing mode (to within the zero tolerance)"))
-            << "\n";
-  return 0;
+  return printOne(scene, a, cyclic, format);
 }
 
 }  // namespace appell::cli

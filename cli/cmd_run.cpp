@@ -1,6 +1,7 @@
 // appell run: the options of a run (run.hpp) from the command line, and its
 // summary printed.
 #include "commands.hpp"
+#include "overrides.hpp"
 #include "plot.hpp"
 
 #include <appell/run.hpp>
@@ -46,6 +47,11 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
   --max-residual R    stop when the constraint residual (max |Av+b|, |gap|)
                       exceeds R, keeping the last state within it (default
                       1e-6; inf switches the watch off)
+  --set NAME=VALUE    override the initial state or a parameter (repeatable):
+                      gravity=gx,gy,gz, speed=V (a floating base's forward
+                      speed), <joint>.position=…, <joint>.velocity=…, or a
+                      coordinate by its CSV name; velocities set are kept and
+                      the others completed by the constraints (minimum norm)
 
 Exit status: 0 success, 1 bad input or an output that could not be written,
 130 interrupted (SIGINT: the summary and the trajectory up to the state reached
@@ -207,13 +213,19 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
-             "max-energy-error", "max-residual"},
+             "max-energy-error", "max-residual", "set"},
             {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kHelp);
     return 0;
   }
-  Scene scene = loadFromArgs(args);
+  // Overrides change the state: check it after them, not at load.
+  const bool overrides = !args.all("set").empty();
+  Scene scene = loadFromArgs(args, !overrides);
+  if (overrides) {
+    applyOverrides(scene, args);
+    checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
+  }
   SimulationSettings s = scene.settings;
   s.duration = args.positiveNumber("duration", s.duration);
   s.dt = args.positiveNumber("dt", s.dt);

@@ -224,3 +224,23 @@ std::vector<std::string> writePlots(const std::string& csv, const std::string& d
 }
 
 }  // namespace appell::cli
+
+namespace appell::cli {
+
+void writeStabilityPlot(const std::string& png, const std::string& parameter,
+                        const std::vector<double>& values, const std::vector<double>& max_real) {
+  const fs::path path = fs::absolute(png);
+  const fs::path dir = path.parent_path();
+  fs::create_directories(dir);
+  const std::string stem = path.stem().string();
+  writeData(dir / (stem + ".dat"), {parameter, "max_real"}, {values, max_real});
+  std::ofstream gp(dir / (stem + ".gp"));
+  gp << header(path.filename().string(), "stability diagram: largest real part of the eigenvalues", 1)
+     << "set xlabel " << quoted(parameter) << "\nset ylabel 'max Re(mu) [1/s]'\n"
+     << "plot " << quoted(stem + ".dat") << " using 1:2 with linespoints title 'largest Re', 0 with lines dt 2 lc 'black' title 'zero'\n";
+  if (!gp.flush()) throw std::runtime_error("cannot write '" + (dir / (stem + ".gp")).string() + "'");
+  gp.close();
+  runGnuplot(dir, stem + ".gp");
+}
+
+}  // namespace appell::cli

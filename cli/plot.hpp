@@ -25,6 +25,12 @@ namespace appell::cli {
 std::vector<std::string> writePlots(const std::string& csv, const std::string& dir,
                                     const Scene* scene);
 
+/// The stability diagram of `appell linearize --sweep … --plot FILE.png`: the
+/// largest real part of the eigenvalues against the swept parameter, with the
+/// zero line (FILE.dat and FILE.gp beside the PNG).
+void writeStabilityPlot(const std::string& png, const std::string& parameter,
+                        const std::vector<double>& values, const std::vector<double>& max_real);
+
 /// The folder `appell plot` and `appell run --plot` use by default: next to
 /// the CSV, named after it ("out/run.csv" → "out/run_plots").
 std::string defaultPlotDir(const std::string& csv);
