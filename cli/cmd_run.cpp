@@ -4,17 +4,21 @@
 #include "overrides.hpp"
 #include "plot.hpp"
 
+#include <appell/output.hpp>
 #include <appell/run.hpp>
 
 #include <unistd.h>
 
-#include <cmath>
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <thread>
 
 namespace appell::cli {
 
@@ -47,6 +51,11 @@ const char* kHelp = R"(usage: appell run SCENE.urdf [options]
   --max-residual R    stop when the constraint residual (max |Av+b|, |gap|)
                       exceeds R, keeping the last state within it (default
                       1e-6; inf switches the watch off)
+  --sweep NAME=START:STOP:COUNT
+                      one run per value of a one-number override, on every
+                      core (no trajectory): how each ended, its energy-balance
+                      error and residual, its final state
+  --format F          with --sweep: text (default), csv or json at full precision
   --set NAME=VALUE    override the initial state or a parameter (repeatable):
                       gravity=gx,gy,gz, speed=V (a floating base's forward
                       speed), <joint>.position=…, <joint>.velocity=…, or a
@@ -210,22 +219,115 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
 
 }  // namespace
 
+// --sweep: one run per value on every core, a row per run — how it ended,
+// the largest energy-balance error and residual, and the final state — at
+// full precision in csv or json.
+int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& args,
+             const RunOptions& options, const std::string& format) {
+  const Sweep sw = parseSweep(args.text("sweep"));
+  struct Row {
+    RunSummary summary;
+    VecX q, v;
+    std::string error;
+  };
+  std::vector<Row> rows(sw.values.size());
+  const unsigned workers = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(),
+                                                           static_cast<unsigned>(rows.size())));
+  auto number = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", x);
+    return std::string(buf);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned w = 0; w < workers; ++w)
+    pool.emplace_back([&, w] {
+      for (std::size_t k = w; k < rows.size(); k += workers) {
+        try {
+          Scene s = base;
+          std::vector<int> kept = kept_base;
+          applyOverride(s, sw.name, number(sw.values[k]), kept);
+          completeVelocities(s, kept);
+          checkInitialState(s, args.has("project-initial"), LoadOptions().initial_state_tolerance);
+          rows[k].summary = runScene(s, options, [&](const Simulator& sim) {
+            rows[k].q = sim.q();
+            rows[k].v = sim.v();
+          });
+        } catch (const std::exception& e) {
+          rows[k].error = e.what();
+        }
+      }
+    });
+  for (std::thread& t : pool) t.join();
+  const std::vector<std::string> qn = coordinateNames(base.model, false), vn = coordinateNames(base.model, true);
+  auto status = [](const Row& r) { return !r.error.empty() ? "error" : r.summary.ok ? "ok" : "failed"; };
+  if (format == "json") {
+    std::cout << "{\"scene\": \"" << base.source << "\", \"parameter\": \"" << sw.name << "\", \"runs\": [";
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Row& r = rows[k];
+      const RunSummary& m = r.summary;
+      std::cout << (k ? ",\n  " : "\n  ") << "{\"value\": " << number(sw.values[k]) << ", \"status\": \"" << status(r)
+                << "\", \"time\": " << number(m.time) << ", \"energy_error\": " << number(m.max_energy_deviation)
+                << ", \"max_residual\": " << number(std::max(m.max_velocity_residual, m.max_gap_residual))
+                << ", \"q\": {";
+      for (int i = 0; i < r.q.size(); ++i) std::cout << (i ? ", " : "") << "\"" << qn[i] << "\": " << number(r.q[i]);
+      std::cout << "}, \"v\": {";
+      for (int i = 0; i < r.v.size(); ++i) std::cout << (i ? ", " : "") << "\"" << vn[i] << "\": " << number(r.v[i]);
+      std::cout << "}}";
+    }
+    std::cout << "]}\n";
+  } else if (format == "csv") {
+    std::cout << sw.name << ",status,time,energy_error,max_residual";
+    for (const std::string& n : qn) std::cout << ",q:" << n;
+    for (const std::string& n : vn) std::cout << ",v:" << n;
+    std::cout << "\n";
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Row& r = rows[k];
+      std::cout << number(sw.values[k]) << "," << status(r) << "," << number(r.summary.time) << ","
+                << number(r.summary.max_energy_deviation) << ","
+                << number(std::max(r.summary.max_velocity_residual, r.summary.max_gap_residual));
+      for (int i = 0; i < base.model.nq; ++i) std::cout << "," << (i < r.q.size() ? number(r.q[i]) : "");
+      for (int i = 0; i < base.model.nv; ++i) std::cout << "," << (i < r.v.size() ? number(r.v[i]) : "");
+      std::cout << "\n";
+    }
+  } else {
+    std::cout << "scene " << base.source << ": " << rows.size() << " runs of " << sw.name << " on " << workers
+              << " threads\n";
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Row& r = rows[k];
+      std::cout << "  " << sw.name << " = " << std::setprecision(8) << sw.values[k] << ": " << status(r);
+      if (!r.error.empty()) std::cout << " (" << r.error << ")";
+      else if (!r.summary.ok) std::cout << " at t = " << r.summary.time << " (" << r.summary.failure << ")";
+      else std::cout << ", |E balance| ≤ " << r.summary.max_energy_deviation << " J, residual ≤ "
+                     << std::max(r.summary.max_velocity_residual, r.summary.max_gap_residual);
+      std::cout << "\n";
+    }
+  }
+  return std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.error.empty() && r.summary.ok; }) ? 0 : 3;
+}
+
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
-             "max-energy-error", "max-residual", "set"},
+             "max-energy-error", "max-residual", "set", "sweep", "format"},
             {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kHelp);
     return 0;
   }
   // Overrides change the state: check it after them, not at load.
-  const bool overrides = !args.all("set").empty();
+  const bool overrides = !args.all("set").empty() || args.has("sweep");
   Scene scene = loadFromArgs(args, !overrides);
+  std::vector<int> kept;
   if (overrides) {
-    applyOverrides(scene, args);
-    checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
+    kept = applyOverrides(scene, args);
+    if (!args.has("sweep"))
+      checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
   }
+  const std::string format = args.text("format", "text");
+  if (format != "text" && format != "csv" && format != "json")
+    throw UsageError("--format must be text, csv or json, not '" + format + "'");
+  if (args.has("format") && !args.has("sweep"))
+    throw UsageError("--format applies to a --sweep's table (a single run's numbers are in --out's CSV)");
   SimulationSettings s = scene.settings;
   s.duration = args.positiveNumber("duration", s.duration);
   s.dt = args.positiveNumber("dt", s.dt);
@@ -251,6 +353,10 @@ int run(int argc, char** argv) {
                                                               : args.positiveNumber("max-residual", 1e-6);
   if (options.output_every < 1) throw UsageError("option --every must be at least 1");
   options.project_positions = options.project_velocities = !args.has("no-projection");
+  if (args.has("sweep")) {
+    if (args.has("out") || args.has("plot")) throw UsageError("--sweep writes a table, not a trajectory (--out, --plot)");
+    return runSweep(scene, kept, args, options, format);
+  }
 
   // SIGINT stops the run after the current step: the state reached is written
   // and flushed, the summary printed, and the exit status is 130.

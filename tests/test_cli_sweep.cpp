@@ -3,6 +3,7 @@
 // equal to the C++ API's results to round-off, and bad overrides named.
 #include <appell/appell.hpp>
 #include <appell/linearization.hpp>
+#include <appell/run.hpp>
 #include <appell/urdf.hpp>
 
 #include "run_command.hpp"
@@ -15,6 +16,7 @@
 #include <complex>
 #include <filesystem>
 #include <regex>
+#include <sstream>
 #include <string>
 
 using namespace appell;
@@ -104,4 +106,47 @@ TEST(CliSweep, BadOverridesAreNamed) {
             std::string::npos);
   EXPECT_NE(err("--sweep spin.velocity=1:2").output.find("START:STOP:COUNT"), std::string::npos);
   EXPECT_EQ(err("--set spin.velocity=x").status, 2);
+}
+
+// appell run --sweep speed=…: one run per value, each on the C++ API's
+// numbers — the car rolls straight at the commanded speed (x = V T), and the
+// final state in the CSV is runScene's on the same state to round-off.
+TEST(CliSweep, RunSweepOfTheCarsSpeedMatchesTheCppApi) {
+  const std::string car = std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf";
+  const auto r = sh("run " + car + " --sweep speed=1:3:3 --duration 1 --format csv");
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::vector<std::vector<std::string>> table;
+  std::stringstream in(r.output);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::stringstream l(line);
+    for (std::string c; std::getline(l, c, ',');) cells.push_back(c);
+    table.push_back(cells);
+  }
+  ASSERT_EQ(table.size(), 4u) << r.output;
+  const auto& head = table[0];
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(head.begin(), head.end(), name) - head.begin());
+  };
+  const std::size_t x = col("q:root_joint.x"), wheel = col("q:front_left_joint");
+  ASSERT_LT(x, head.size());
+  for (int k = 1; k <= 3; ++k) {
+    EXPECT_EQ(table[k][1], "ok");
+    EXPECT_NEAR(std::stod(table[k][x]), k * 1.0, 1e-9);  // V T, V = 1, 2, 3
+  }
+  // The C++ API on the same state: root vx = 2, the rest completed.
+  Scene s = loadScene(car);
+  const int vx = s.model.joints[0].idx_v + 3;
+  s.v0.setZero();
+  s.v0[vx] = 2;
+  std::vector<int> dependent;
+  for (int j = 0; j < s.model.nv; ++j)
+    if (j != vx) dependent.push_back(j);
+  scenes::completeVelocity(s.model, s.constraints, s.q0, s.v0, dependent);
+  RunOptions o = runOptions(s.settings);
+  o.duration = 1;
+  VecX q;
+  runScene(s, o, [&](const Simulator& sim) { q = sim.q(); });
+  EXPECT_NEAR(std::stod(table[2][x]), q[0], 1e-12);
+  EXPECT_NEAR(std::stod(table[2][wheel]), q[s.model.joints[s.model.jointIndex("front_left_joint")].idx_q], 1e-10);
 }
