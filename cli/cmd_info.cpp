@@ -141,6 +141,10 @@ int info(int argc, char** argv) {
               << " (" << closed - rank << " redundant), " << m.nv - rank
               << " independent velocities; residuals |Av+b| = " << sim->velocityResidual()
               << ", gap = " << sim->gapResidual() << "\n";
+    if (m.nv > 0 && m.nv - rank == 0)
+      std::cerr << "appell info: warning: " << scene.source
+                << ": the constraints leave 0 independent velocities — nothing in this scene can move "
+                   "(axles out of line? rows that contradict each other?)\n";
     if (cd.singular) std::cout << "singular contact geometry: " << cd.singular_reason << "\n";
     if (!sim->lastStateError().empty())
       std::cout << "the initial state cannot start: " << sim->lastStateError() << "\n";

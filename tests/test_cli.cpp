@@ -247,6 +247,12 @@ TEST(Cli, RunWarnsWhenTheConstraintsLeaveNoFreedom) {
   EXPECT_NE(r.output.find("warning: " + bad + ": the constraints leave 0 independent velocities"),
             std::string::npos)
       << r.output;
+  // appell info says so too (and not for the good car).
+  const Result info = sh("info " + bad + " --project-initial");
+  EXPECT_NE(info.output.find("appell info: warning: " + bad + ": the constraints leave 0 independent velocities"),
+            std::string::npos)
+      << info.output;
+  EXPECT_EQ(sh("info " + car).output.find("warning"), std::string::npos);
 }
 
 // --cyclic takes a coordinate by its position name as well as by its
