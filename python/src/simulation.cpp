@@ -120,7 +120,7 @@ void Simulation::rowResiduals(VecX& residual, VecX& gap) {
     const RowBlock& blk = cdata_->blocks[k];
     const int o = cdata_->offset[k];
     if (c.jointSpace()) {
-      for (int i = 0; i < c.rows(); ++i) residual[o + i] = blk.A_joint.row(i).dot(v) + cdata_->b[o + i];
+      for (int i = 0; i < c.rows(); ++i) residual[o + i] = jointRowDot(blk, i, v) + cdata_->b[o + i];
       continue;
     }
     // wₐ·Vₐ − w_b·V_b + b with world-frame body velocities (constraint.hpp).

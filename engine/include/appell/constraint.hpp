@@ -10,8 +10,11 @@
 // layer knows the curvatures, the engine knows the tree. A point-velocity row
 // tᵀ ṗ for a point x on the body is w = [x × t; t].
 //
-// Rows that are not naturally body-local (user-supplied rows over v) say
-// jointSpace() and give A, b and Ȧv + ḃ over the generalized velocities.
+// Rows that are not naturally body-local (user-supplied rows over v, joint
+// limits, mimic couplings) say jointSpace() and give A, b and Ȧv + ḃ over the
+// generalized velocities — sparse: only over the columns jointColumns()
+// names (a joint limit: one; a coupling: two), so a model with a limit on
+// every joint stores O(n), not O(n²).
 //
 // Each row says what it means (RowKind): λ of a row with direction t is the
 // force along t on the body, so the normal row carries the normal load and
@@ -23,6 +26,7 @@
 
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace appell {
 
@@ -61,7 +65,11 @@ struct RowBlock {
   RowMatrix6 Wa, Wb;                ///< m × 6, world-frame spatial covectors
   RowVector6 b, kappa;              ///< velocity and acceleration offsets
   RowVector6 gap;                   ///< holonomic gap per row (0 where not holonomic)
-  MatX A_joint;                     ///< jointSpace(): m × nv
+  /// jointSpace(): the velocity indices the rows act on (jointColumns(),
+  /// set once by reserve) and the rows over them,
+  ///     row r · v = Σₖ A_joint(r, k) v[joint_cols[k]].
+  std::vector<int> joint_cols;
+  MatX A_joint;                     ///< jointSpace(): m × joint_cols.size()
   VecX b_joint, abias_joint;        ///< jointSpace(): b and Ȧv + ḃ (size m)
   ContactFrame frame;
   bool singular = false;            ///< the geometry is singular here (rows unusable)
@@ -86,6 +94,10 @@ class Constraint {
   virtual bool holonomic(int k) const = 0;
   /// Rows given over v (A_joint …) rather than as body covectors.
   virtual bool jointSpace() const { return false; }
+  /// jointSpace(): the velocity indices its rows may involve (the columns
+  /// of RowBlock::A_joint), fixed for the constraint's lifetime. Default:
+  /// all of v (a dense row).
+  virtual std::vector<int> jointColumns(const Model& model) const;
   /// A unilateral constraint (a contact, a joint limit) can open. Its row
   /// unilateralRow() is ġ of a gap g(q) ≥ 0 whose multiplier may only push
   /// (λ ≥ 0, the force along the row's direction): while closed all its rows
@@ -108,5 +120,18 @@ class Constraint {
   virtual void evaluate(const Model& model, const Data& data, double t, const VecX& q,
                         const VecX& v, RowBlock& out) const = 0;
 };
+
+/// Joint-space row r of `blk` applied to x (size nv): Σₖ A_joint(r, k) x[cols[k]].
+inline double jointRowDot(const RowBlock& blk, int r, const VecX& x) {
+  double s = 0;
+  for (size_t k = 0; k < blk.joint_cols.size(); ++k) s += blk.A_joint(r, k) * x[blk.joint_cols[k]];
+  return s;
+}
+
+/// out += scale · (joint-space row r of `blk`)ᵀ, out of size nv.
+inline void addJointRow(const RowBlock& blk, int r, double scale, Eigen::Ref<VecX> out) {
+  for (size_t k = 0; k < blk.joint_cols.size(); ++k)
+    out[blk.joint_cols[k]] += scale * blk.A_joint(r, k);
+}
 
 }  // namespace appell

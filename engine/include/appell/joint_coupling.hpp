@@ -31,6 +31,8 @@ class JointCoupling : public Constraint {
   std::string rowLabel(int) const override { return "coupling"; }
   bool holonomic(int) const override { return true; }
   bool jointSpace() const override { return true; }
+  /// The follower's and the leader's velocities (columns 0 and 1 of A_joint).
+  std::vector<int> jointColumns(const Model&) const override { return {fv_, lv_}; }
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;

@@ -33,6 +33,9 @@ class JointLimit : public Constraint {
   std::string rowLabel(int) const override { return "limit"; }
   bool holonomic(int) const override { return true; }
   bool jointSpace() const override { return true; }
+  /// The limited joint's one velocity: the tree solver takes the row inside
+  /// its factor pass (a closed limit locks the joint), O(1) per limit.
+  std::vector<int> jointColumns(const Model&) const override { return {iv_}; }
   int unilateralRow() const override { return 0; }
   double restitution() const override { return restitution_; }
   void reserve(const Model& model, RowBlock& block) const override;

@@ -1,5 +1,7 @@
 #include <appell/constraint.hpp>
 
+#include <stdexcept>
+
 namespace appell {
 
 const char* toString(RowKind kind) {
@@ -20,11 +22,23 @@ std::string Constraint::rowLabel(int k) const {
   return toString(kind);
 }
 
+std::vector<int> Constraint::jointColumns(const Model& model) const {
+  std::vector<int> all(model.nv);
+  for (int k = 0; k < model.nv; ++k) all[k] = k;
+  return all;
+}
+
 void Constraint::reserve(const Model& model, RowBlock& block) const {
   const int m = rows();
   block.m = m;
   if (jointSpace()) {
-    block.A_joint = MatX::Zero(m, model.nv);
+    block.joint_cols = jointColumns(model);
+    for (int k : block.joint_cols)
+      if (k < 0 || k >= model.nv)
+        throw std::invalid_argument("constraint '" + name() + "': joint column " +
+                                    std::to_string(k) + " outside v (nv = " +
+                                    std::to_string(model.nv) + ")");
+    block.A_joint = MatX::Zero(m, static_cast<int>(block.joint_cols.size()));
     block.b_joint = VecX::Zero(m);
     block.abias_joint = VecX::Zero(m);
   } else {

@@ -136,8 +136,10 @@ void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList
 void assembleConstraintRows(const Model& model, const Data& data, const Constraint& c,
                             const RowBlock& blk, MatX& J, Eigen::Ref<MatX> A,
                             Eigen::Ref<VecX> abias) {
-  if (c.jointSpace()) {
-    A = blk.A_joint;
+  if (c.jointSpace()) {  // scatter the sparse columns
+    A.setZero();
+    for (size_t k = 0; k < blk.joint_cols.size(); ++k)
+      A.col(blk.joint_cols[k]) = blk.A_joint.col(static_cast<int>(k));
     abias = blk.abias_joint;
     return;
   }
@@ -190,7 +192,7 @@ double velocityResidual(const Data& data, const ConstraintList& constraints,
     if (!cd.isActive(static_cast<int>(k))) continue;
     if (c.jointSpace()) {
       for (int i = 0; i < m; ++i)
-        r = std::max(r, std::abs(blk.A_joint.row(i).dot(v) + cd.b[o + i]));
+        r = std::max(r, std::abs(jointRowDot(blk, i, v) + cd.b[o + i]));
       continue;
     }
     // wₐ·Vₐ − w_b·V_b + b with world-frame body velocities V = ᵒX V^body.

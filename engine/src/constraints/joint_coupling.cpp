@@ -46,8 +46,8 @@ void JointCoupling::evaluate(const Model&, const Data& data, double, const VecX&
                              RowBlock& out) const {
   out.m = 1;
   out.A_joint.setZero();
-  out.A_joint(0, fv_) = 1;            // ġ = v_f − m v_l
-  out.A_joint(0, lv_) -= multiplier_;
+  out.A_joint(0, 0) = 1;              // ġ = v_f − m v_l (columns fv_, lv_)
+  out.A_joint(0, 1) = -multiplier_;
   out.b_joint[0] = 0;
   out.abias_joint[0] = 0;
   out.gap[0] = q[fq_] - multiplier_ * q[lq_] - offset_;

@@ -36,7 +36,7 @@ void JointLimit::evaluate(const Model& model, const Data& data, double, const Ve
   (void)model;
   out.m = 1;
   out.A_joint.setZero();
-  out.A_joint(0, iv_) = sign_;  // ġ = ±q̇
+  out.A_joint(0, 0) = sign_;  // ġ = ±q̇ (column iv_)
   out.b_joint[0] = 0;
   out.abias_joint[0] = 0;
   out.gap[0] = sign_ * (q[iq_] - bound_);

@@ -223,7 +223,7 @@ void applyBaumgarte(const Data& data, const ConstraintList& constraints, Constra
     }
     for (int r = 0; r < m; ++r) {
       double value = cdata.b[o + r];
-      if (c.jointSpace()) value += blk.A_joint.row(r).dot(v);
+      if (c.jointSpace()) value += jointRowDot(blk, r, v);
       else value += blk.Wa.row(r).dot(Va) - (bb >= 0 ? blk.Wb.row(r).dot(Vb) : 0.0);
       const double add = 2.0 * alpha * value + beta * beta * cdata.gap[o + r];
       if (c.jointSpace()) blk.abias_joint[r] += add;

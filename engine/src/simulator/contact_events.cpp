@@ -53,7 +53,10 @@ void Simulator::setUpUnilateral() {
     r.joint = con.jointSpace();
     r.a = con.bodyA();
     r.b = con.bodyB();
-    if (r.joint) r.a_joint = VecX::Zero(model_.nv);
+    if (r.joint) {
+      r.cols = cdata_->blocks[c].joint_cols;
+      r.a_joint = VecX::Zero(static_cast<int>(r.cols.size()));
+    }
     const double mu = con.friction();
     if (!(mu >= 0))
       throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has friction μ = " +
@@ -339,10 +342,21 @@ bool Simulator::projectAfterModes(std::string& error) {
 
 // ------------------------------------------------------------ mode decision
 
+namespace {
+
+/// A saved joint-space row (over its columns) applied to x.
+double sparseDot(const UnilateralRow& r, const VecX& x) {
+  double s = 0;
+  for (size_t k = 0; k < r.cols.size(); ++k) s += r.a_joint[static_cast<int>(k)] * x[r.cols[k]];
+  return s;
+}
+
+}  // namespace
+
 /// γ = ġ of unilateral row k from its saved row, at data_'s velocities.
 double Simulator::rowVelocity(int k) const {
   const UnilateralRow& r = uni_->rows[k];
-  if (r.joint) return r.a_joint.dot(v_) + r.bval;
+  if (r.joint) return sparseDot(r, v_) + r.bval;
   double g = r.bval;
   if (r.a >= 0) g += r.wa.dot(data_->oMi[r.a].act(data_->v[r.a]));
   if (r.b >= 0) g -= r.wb.dot(data_->oMi[r.b].act(data_->v[r.b]));
@@ -352,7 +366,7 @@ double Simulator::rowVelocity(int k) const {
 /// γ̇ of unilateral row k, data_ holding forwardKinematics(q, v, v̇).
 double Simulator::rowAcceleration(int k) const {
   const UnilateralRow& r = uni_->rows[k];
-  if (r.joint) return r.a_joint.dot(uni_->vdot) + r.abias;
+  if (r.joint) return sparseDot(r, uni_->vdot) + r.abias;
   double g = r.kappa;
   if (r.a >= 0) g += r.wa.dot(spatialAccelerationWorld(*data_, r.a));
   if (r.b >= 0) g -= r.wb.dot(spatialAccelerationWorld(*data_, r.b));

@@ -82,7 +82,8 @@ struct UnilateralRow {
   int a = -1, b = -1;
   Vec6 wa = Vec6::Zero(), wb = Vec6::Zero();
   double bval = 0, kappa = 0, abias = 0;
-  VecX a_joint;
+  VecX a_joint;            // joint-space row over cols (RowBlock::joint_cols)
+  std::vector<int> cols;
   double gap = 0;         // at the decision's state
   double gamma = 0;       // normal velocity before the impact
   double target = 0;      // e γ⁻: the impact shifts the row to γ⁺ = −e γ⁻

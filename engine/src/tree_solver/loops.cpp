@@ -27,7 +27,7 @@ namespace {
 double applyRow(const ConstraintData& cdata, const Data& data, const TreeWorkspace& ws,
                 const LoopRow& lr) {
   const RowBlock& blk = cdata.blocks[lr.constraint];
-  if (lr.joint_space) return blk.A_joint.row(lr.row).dot(ws.vdot0);
+  if (lr.joint_space) return jointRowDot(blk, lr.row, ws.vdot0);
   const Vec6 aA = data.oMi[lr.bodyA].act(ws.a0[lr.bodyA]);
   const Vec6 aB = data.oMi[lr.bodyB].act(ws.a0[lr.bodyB]);
   return blk.Wa.row(lr.row).dot(aA) - blk.Wb.row(lr.row).dot(aB);
@@ -50,13 +50,16 @@ double freeShare(const Model& model, const Data& data, const ConstraintData& cda
     ws.floop[lr.bodyB] -= data.oMi[lr.bodyB].actInvForce(blk.Wb.row(lr.row).transpose());
   }
   double mv2 = 0, f2 = 0;
+  if (lr.joint_space) {  // B_lᵀ over v: ‖f‖² straight from its columns
+    for (size_t k = 0; k < blk.joint_cols.size(); ++k) { const double a = blk.A_joint(lr.row, k); f2 += a * a; }
+  }
   for (int i = model.nbodies - 1; i >= 0; --i) {
     const Joint& j = model.joints[i];
     for (int c = 0; c < j.nv; ++c) {
       const double m = j.S.col(c).dot(ws.fsub[i]);
-      double f = j.S.col(c).dot(ws.floop[i]);
-      if (lr.joint_space) f += blk.A_joint(lr.row, j.idx_v + c);
       mv2 += m * m;
+      if (lr.joint_space) continue;
+      const double f = j.S.col(c).dot(ws.floop[i]);
       f2 += f * f;
     }
     const int p = model.parent[i];
@@ -77,7 +80,7 @@ void loopTargets(const Model& model, const Data& data, const ConstraintData& cda
     const RowBlock& blk = cdata.blocks[lr.constraint];
     double t;
     if (lr.joint_space) {
-      t = impulse ? -(blk.A_joint.row(lr.row).dot(v) + blk.b_joint[lr.row])
+      t = impulse ? -(jointRowDot(blk, lr.row, v) + blk.b_joint[lr.row])
                   : -blk.abias_joint[lr.row];
     } else if (impulse) {
       const Vec6 VA = data.oMi[lr.bodyA].act(data.v[lr.bodyA]);
@@ -118,7 +121,7 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
     const RowBlock& blk = cdata.blocks[lr.constraint];
     ws.tau.setZero();
     if (lr.joint_space) {
-      ws.tau = blk.A_joint.row(lr.row).transpose();
+      addJointRow(blk, lr.row, 1.0, ws.tau);
     } else {
       // bias0 is minus the external force, body frame.
       ws.nodes[lr.bodyA].bias0 -= data.oMi[lr.bodyA].actInvForce(blk.Wa.row(lr.row).transpose());

@@ -71,7 +71,7 @@ void reactionForces(const Model& model, const Data& data, const ConstraintData& 
     const RowBlock& blk = cdata.blocks[lr.constraint];
     const double l = lambda[lr.global];
     if (lr.joint_space) {
-      reaction.noalias() += l * blk.A_joint.row(lr.row).transpose();
+      addJointRow(blk, lr.row, l, reaction);
       continue;
     }
     ws.fsub[lr.bodyA] += l * blk.Wa.row(lr.row).transpose();
