@@ -98,3 +98,27 @@ TEST(TreeSolverAllocations, NoneWithRedundantLoopRows) {
   EXPECT_GT(out.redundant, 1);
   expectNoAllocation(s);
 }
+
+TEST(TreeSolverAllocations, NoneWithLockedJoints) {
+  // Closed rows on one-DoF joints' velocities (tree_solver/locked.cpp): one
+  // or two per joint, next to duplicated and compliant body rows, so the
+  // locked split, the compliant split with no joint and the minimum-norm
+  // row of a locked joint all run.
+  std::mt19937 rng(35);
+  for (bool floating : {false, true}) {
+    System s = randomSystem(20, floating, rng, RowRecipe{0.3, 0.3, 2});
+    addWeakRows(s, 3, 1e-3, rng);
+    for (int i = 0; i < s.model.nbodies; ++i) {
+      if (s.model.joints[i].nv != 1) continue;
+      for (int r = 0; r < 1 + i % 2; ++r)
+        s.joint.push_back(std::make_shared<JointRows>(
+            "lock" + std::to_string(r) + "@" + std::to_string(i), MatX::Constant(1, 1, 1.0 + r),
+            std::vector<int>{s.model.joints[i].idx_v}));
+    }
+    makeConsistent(s, rng);
+    const ConstrainedResult out = treeSolve(s);
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_GT(out.redundant, 0);
+    expectNoAllocation(s);
+  }
+}

@@ -59,11 +59,16 @@ class LocalRows : public Constraint {
   VecX kappa_, bvel_;
 };
 
-/// Rows over the generalized velocities.
+/// Rows over the generalized velocities: dense, or over the columns `cols`
+/// only (A then has one column per entry of cols).
 class JointRows : public Constraint {
  public:
-  JointRows(std::string name, const MatX& A)
-      : name_(std::move(name)), A_(A), abias_(VecX::Zero(A.rows())), b_(VecX::Zero(A.rows())) {}
+  JointRows(std::string name, const MatX& A, std::vector<int> cols = {})
+      : name_(std::move(name)), A_(A), abias_(VecX::Zero(A.rows())), b_(VecX::Zero(A.rows())),
+        cols_(std::move(cols)) {}
+  std::vector<int> jointColumns(const Model& model) const override {
+    return cols_.empty() ? Constraint::jointColumns(model) : cols_;
+  }
   const std::string& name() const override { return name_; }
   int rows() const override { return static_cast<int>(A_.rows()); }
   int bodyA() const override { return -1; }
@@ -84,6 +89,7 @@ class JointRows : public Constraint {
   std::string name_;
   MatX A_;
   VecX abias_, b_;
+  std::vector<int> cols_;
 };
 
 /// A system under test: model, state, constraints (kept mutable for their right sides).

@@ -65,6 +65,9 @@ class TreeSolver : public ConstrainedSolver {
   /// Number of loop-closing rows (two moving bodies or joint-space rows)
   /// handled by the Schur complement.
   int loopRows() const;
+  /// Rows found redundant (or zero) by the last solve or projectVelocity:
+  /// the rank of the active rows is m_active minus this.
+  int redundantRows() const;
   const std::string& lastError() const override;
 
  private:

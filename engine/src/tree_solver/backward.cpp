@@ -302,8 +302,11 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       // Dropped rows with no compliance: redundant, their multipliers free.
       cur->nfree = soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
       nd.nfree += cur->nfree;
-      cur = &nd.comp[++nd.ncomp];
-      cur->nseg = 0;
+      // The next stack, if any group is left to start one (the constructor
+      // sized comp for the most compressions the groups can cause).
+      ++nd.ncomp;
+      cur = nd.ncomp < static_cast<int>(nd.comp.size()) ? &nd.comp[nd.ncomp] : nullptr;
+      if (cur) cur->nseg = 0;
     };
     for (const Segment& g : nd.groups) {
       const int r = g.kind == Segment::Block ? ws.blocks[g.id].rows : ws.nodes[g.id].npass;
@@ -323,7 +326,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       cur->seg[cur->nseg++] = {g.kind, g.id, r};
       nb += r;
     }
-    if (cur->nseg > 0) compressStack();
+    if (cur && cur->nseg > 0) compressStack();
 
     // 2. Split the joint: G = K S = U Σ Vᵀ; rows along U₁ fix V₁ᵀ q̈, rows
     //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.
@@ -333,8 +336,25 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     Mat6 H;
     nd.soft = false;
     nd.softpass = false;
+    // Closed joint-space rows on this joint lock it (tree_solver/locked.cpp).
+    nd.locked = false;
+    if (!nd.jrows.empty()) {
+      nd.c2 = 0;
+      int closed = 0;
+      for (JointRow& r : nd.jrows) {
+        r.active = cdata.isActive(r.constraint);
+        r.c = r.active ? cdata.blocks[r.constraint].A_joint(r.row, 0) : 0.0;
+        r.active = r.active && r.c != 0;  // a zero row locks nothing (λ = 0)
+        nd.c2 += r.c * r.c;
+        closed += r.active ? 1 : 0;
+      }
+      nd.locked = closed > 0;
+      if (closed > 1) ws.redundant += closed - 1;  // one row on q̈, split by min norm
+    }
     const bool soft_rows = nd.ncomp > 0 && nd.comp[nd.ncomp - 1].soft;
-    if (soft_rows || !(j.nv == 1 ? splitOneDof(o, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))
+    if (nd.locked)
+      splitLocked(ws, j, p < 0, nd, H);
+    else if (soft_rows || !(j.nv == 1 ? splitOneDof(o, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))
       splitSoft(ws, j, p < 0, nd, H);
     if (p < 0) nd.nfree += nd.npass;  // rows no joint can move: their combinations are zero rows of A
     if (nd.nfree > 0) {  // tree_solver/min_norm.cpp starts from these bodies
@@ -358,6 +378,7 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
     Node& nd = ws.nodes[i];
     const Joint& j = model.joints[i];
     const int p = model.parent[i];
+    if (nd.locked && !lockedRhs(ws, i, check) && check) return false;
 
     // Right sides through the recorded compressions: Qᵀ E r.
     for (int e = 0; e < nd.ncomp; ++e) {
@@ -399,13 +420,15 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
 
     if (nd.soft) {
       Vec6 pa;
-      softBias(j, nd, ws.tau, pa);
+      softBias(nd.locked ? lockedJoint() : j, nd, ws.tau, pa);
       if (p >= 0) {
         if (ws.use_c) pa += nd.Hc;
+        if (nd.locked) pa += nd.rho * nd.Hs;  // a = ā + s ρ: ρ enters as c does
         ws.nodes[p].pA += data.liMi[i].actForce(pa);
       }
       nd.kpass = nd.kv.head(nd.npass);
       if (ws.use_c && nd.npass > 0) nd.kpass -= nd.kpc;
+      if (nd.locked && nd.npass > 0) nd.kpass -= nd.rho * nd.kps;
       continue;
     }
     const auto tau = ws.tau.segment(j.idx_v, j.nv);
@@ -436,11 +459,13 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
         g.noalias() -= nd.GK.transpose() * sx;
       }
       g += pa;
+      if (nd.locked) g += nd.rho * nd.Hs;  // a = ā + s ρ: ρ enters as c does
       ws.nodes[p].pA += data.liMi[i].actForce(g);
     }
     if (nd.npass > 0) {
       applyU2t(nd, nd.k, nd.kpass);
       if (ws.use_c) nd.kpass -= nd.kpc;
+      if (nd.locked) nd.kpass -= nd.rho * nd.kps;
     } else {
       nd.kpass.resize(0);
     }

@@ -36,6 +36,23 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
       }
     }
 
+    if (nd.locked) {  // q̈ = ρ fixed by the joint's closed rows (tree_solver/locked.cpp)
+      abar += nd.rho * j.S.col(0);
+      if (nd.soft) {
+        softForward(lockedJoint(), nd, abar, ws.vdot);
+      } else {
+        nd.a = abar;
+        if (nd.ncomp > 0) {
+          KVec& mu = nd.comp[nd.ncomp - 1].mu;
+          mu.setZero(nd.nK);
+          if (nd.npass > 0) addU2(nd, nd.nu, mu);
+        }
+      }
+      ws.vdot[j.idx_v] = nd.rho;
+      lockedForce(j, nd, ws.tau[j.idx_v], ws.lambda);
+      if (nd.ncomp > 0) unrollNode(ws, i, nd.ncomp - 1, ws.lambda);
+      continue;
+    }
     if (nd.soft) {
       softForward(j, nd, abar, ws.vdot);
       unrollNode(ws, i, nd.ncomp - 1, ws.lambda);

@@ -116,6 +116,8 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
   ws.a_world.setZero();
   for (auto& nd : ws.nodes) nd.bias0.setZero();
   for (auto& tb : ws.blocks) tb.rhs.setZero();
+  for (int b : ws.jrow_nodes)
+    for (auto& jr : ws.nodes[b].jrows) jr.rhs = 0;
   for (int l = 0; l < k; ++l) {
     const LoopRow& lr = ws.loops[l];
     const RowBlock& blk = cdata.blocks[lr.constraint];

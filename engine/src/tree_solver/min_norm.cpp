@@ -234,6 +234,26 @@ void costOfCompression(TreeWorkspace& ws, int i, int e, Kept kept, const VecX& l
     for (int k = 0; k < g.rows; ++k) F.col[nvar][at + k] = in[k];
     at += g.rows;
   }
+  if (nd.locked && e == nd.ncomp - 1 && kept == Kept::Nu) {
+    // A locked joint's rows (tree_solver/locked.cpp): their force ℓ moves
+    // with the kept multipliers, δℓ = −(K s)ᵀ δμ, δμ = U₂ δν, and their λ =
+    // c ℓ / Σc² costs (ℓ + δℓ)² / Σc².
+    const double w = 1.0 / std::sqrt(nd.c2);
+    for (int c = 0; c < z; ++c) F.col[c][nb] = 0;
+    KVec unit(nk), dmu(nd.nK);
+    for (int c = 0; c < nk; ++c) {
+      unit.setZero();
+      unit[c] = 1;
+      dmu.setZero();
+      addU2(nd, unit, dmu);
+      F.col[z + c][nb] = -w * nd.gl.dot(dmu);
+    }
+    double ell = 0;
+    for (const JointRow& jr : nd.jrows)
+      if (jr.active) ell += jr.c * lambda[jr.global];
+    F.col[nvar][nb] = w * ell;
+    F.rows = nb + 1;
+  }
   triangularize(F, nvar);
   cp.mnTop.resize(z, nvar + 1);
   for (int c = 0; c <= nvar; ++c)
@@ -276,6 +296,11 @@ void replayNode(const Model& model, TreeWorkspace& ws, int i, VecX& lambda) {
   KVec& top = nd.comp[nd.ncomp - 1].dmu;
   top.setZero(nd.nK);
   if (up) addU2(nd, dnu, top);
+  if (up && nd.locked) {  // the locked joint's rows follow: δℓ = −(K s)ᵀ δμ
+    const double dl = -nd.gl.dot(top);
+    for (const JointRow& jr : nd.jrows)
+      if (jr.active) lambda[jr.global] += jr.c * dl / nd.c2;
+  }
   for (int e = nd.ncomp - 1; e >= 0; --e) {
     Compression& cp = nd.comp[e];
     BufVec t(cp.nfree), y;

@@ -77,6 +77,9 @@ void reactionForces(const Model& model, const Data& data, const ConstraintData& 
     ws.fsub[lr.bodyA] += l * blk.Wa.row(lr.row).transpose();
     ws.fsub[lr.bodyB] -= l * blk.Wb.row(lr.row).transpose();
   }
+  for (int b : ws.jrow_nodes)  // rows on one joint's velocity: c λ on it
+    for (const JointRow& r : ws.nodes[b].jrows)
+      if (r.active) reaction[model.joints[b].idx_v] += r.c * lambda[r.global];
   for (int i = model.nbodies - 1; i >= 0; --i) {
     const int p = model.parent[i];
     const Joint& j = model.joints[i];
@@ -124,6 +127,7 @@ std::string describeFailure(const Model& model, const Data& data, TreeWorkspace&
     nd.nu = nd.kpass - nd.Kpass * xa;
     nd.comp[nd.ncomp - 1].mu.setZero(nd.nK);
     addU2(nd, nd.nu, nd.comp[nd.ncomp - 1].mu);
+    if (nd.locked) lockedCertificate(nd, cert);
     unrollNode(ws, i, nd.ncomp - 1, cert);
   }
   for (int j = i + 1; j < model.nbodies; ++j) {
@@ -131,6 +135,7 @@ std::string describeFailure(const Model& model, const Data& data, TreeWorkspace&
     if (!model.isAncestor(i, j) || c.ncomp == 0 || c.npass == 0) continue;
     c.comp[c.ncomp - 1].mu.setZero(c.nK);
     addU2(c, c.nu, c.comp[c.ncomp - 1].mu);
+    if (c.locked) lockedCertificate(c, cert);
     unrollNode(ws, j, c.ncomp - 1, cert);
   }
 
@@ -141,6 +146,14 @@ std::string describeFailure(const Model& model, const Data& data, TreeWorkspace&
     if (!names.empty()) names += ", ";
     names += "'" + ws.names[tb.constraint] + "'";
   }
+  for (int b : ws.jrow_nodes)
+    for (const JointRow& r : ws.nodes[b].jrows) {
+      if (!r.active || std::abs(cert[r.global]) <= 1e-8 * big) continue;
+      const std::string n = "'" + ws.names[r.constraint] + "'";
+      if (names.find(n) != std::string::npos) continue;
+      if (!names.empty()) names += ", ";
+      names += n;
+    }
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.3g", f.residual);
   return "inconsistent constraints " + names + " (detected at body '" + model.body_names[i] +

@@ -41,7 +41,27 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
       if (A < 0 && B < 0) fail("acts on no moving body (both bodies are the world)");
       if (rows > 6) fail("writes " + std::to_string(rows) + " body rows (at most 6)");
     }
-    if (con.jointSpace() || (A >= 0 && B >= 0)) {
+    // A joint-space constraint on the one velocity of a one-DoF joint (a
+    // joint limit) is taken by that joint's node (tree_solver/locked.cpp).
+    int own_joint = -1;
+    if (con.jointSpace()) {
+      const std::vector<int> cols = con.jointColumns(model);
+      if (cols.size() == 1 && cols[0] >= 0 && cols[0] < model.nv) {
+        const int b = model.body_of_v[cols[0]];
+        if (model.joints[b].nv == 1) own_joint = b;
+      }
+    }
+    if (own_joint >= 0) {
+      auto& jr = ws.nodes[own_joint].jrows;
+      if (jr.empty()) ws.jrow_nodes.push_back(own_joint);
+      for (int r = 0; r < rows; ++r) {
+        detail::JointRow row;
+        row.constraint = static_cast<int>(c);
+        row.row = r;
+        row.global = global + r;
+        jr.push_back(row);
+      }
+    } else if (con.jointSpace() || (A >= 0 && B >= 0)) {
       for (int r = 0; r < rows; ++r)
         ws.loops.push_back({static_cast<int>(c), r, global + r, con.jointSpace(), A, B});
     } else if (rows > 0) {
@@ -59,10 +79,14 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
     global += rows;
   }
   ws.m = global;
+  std::sort(ws.jrow_nodes.begin(), ws.jrow_nodes.end());
   for (int i = 0; i < model.nbodies; ++i)
     for (int ch : model.children[i]) ws.nodes[i].groups.push_back({Segment::Child, ch, 0});
   for (auto& nd : ws.nodes) {
-    nd.comp.resize(nd.groups.size() + 1);
+    // A stack is compressed when the next group would overflow it (never
+    // before the first group) and once at the end: at most one compression
+    // per group, and one slot for a body with none.
+    nd.comp.resize(std::max<size_t>(1, nd.groups.size()));
     nd.K.resize(0, 6);
     nd.k.resize(0);
     nd.nu.resize(0);
@@ -104,6 +128,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
 TreeSolver::~TreeSolver() = default;
 
 int TreeSolver::loopRows() const { return static_cast<int>(ws_->loops.size()); }
+int TreeSolver::redundantRows() const { return ws_->last_redundant; }
 const std::string& TreeSolver::lastError() const { return ws_->last_error; }
 
 namespace {
@@ -180,6 +205,8 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     for (int r = 0; r < tb.rows; ++r)
       tb.rhs[r] = -blk.kappa[r] - tb.sign * W.row(r).tail<3>().dot(model.gravity);
   }
+  for (int b : ws.jrow_nodes)  // c q̈ + (Ȧv + ḃ) = 0; gravity does not enter
+    for (auto& jr : ws.nodes[b].jrows) jr.rhs = -cdata.blocks[jr.constraint].abias_joint[jr.row];
   ws.tau = tau;
   ws.a_world = spatial(Vec3::Zero(), -model.gravity);
   ws.use_c = true;
@@ -195,6 +222,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   ws.redundant += static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank;
   out.vdot = ws.vdot;
   out.redundant = ws.redundant - zero_rows;
+  ws.last_redundant = out.redundant;
   out.rank = cdata.m_active - out.redundant;
   if (outputs == SolveOutputs::Accelerations) return;  // an integrator stage: v̇ is all it reads
   if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);  // zero rows too: their λ = 0
@@ -227,6 +255,11 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     const Vec6 V = data.oMi[tb.body].act(data.v[tb.body]);
     for (int r = 0; r < tb.rows; ++r) tb.rhs[r] = -(tb.sign * W.row(r).dot(V) + blk.b[r]);
   }
+  for (int b : ws.jrow_nodes)
+    for (auto& jr : ws.nodes[b].jrows) {
+      const RowBlock& blk = cdata.blocks[jr.constraint];
+      jr.rhs = -(jointRowDot(blk, jr.row, v) + blk.b_joint[jr.row]);
+    }
   ws.tau.setZero();
   ws.a_world.setZero();
   ws.use_c = false;
@@ -237,8 +270,9 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     ws.last_error = detail::describeFailure(model, data, ws);
     return false;
   }
-  if (ws.redundant + static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank > 0)
-    detail::minimumNorm(model, ws, ws.lambda);
+  ws.redundant += static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank;
+  ws.last_redundant = ws.redundant - zero_rows;
+  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);
   v += ws.vdot;
   impulse = -ws.lambda;  // the shared convention: v⁺ = v − M⁻¹Aᵀμ
   return true;

@@ -29,11 +29,11 @@ using StackMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12
 /// multipliers (tree_solver/min_norm.cpp): ≤ 12 × (≤ 12 unknowns + right side).
 using AugMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 13>;
 
-/// A least-squares system ‖F [x; 1]‖ of at most 12 rows and 12 unknowns
+/// A least-squares system ‖F [x; 1]‖ of at most 13 rows and 12 unknowns
 /// (tree_solver/min_norm.cpp), column-major: col[k][r] = F(r, k).
 struct LsSystem {
   int rows = 0, cols = 0;
-  alignas(16) double col[13][12];
+  alignas(16) double col[13][13];  ///< 12 stacked rows, and a locked joint's force
 };
 
 /// A kept singular value of K S below this (rows equilibrated, S unit) is a
@@ -94,6 +94,22 @@ struct TreeBlock {
   int declared = 0;            ///< the constraint's rows
   int global = -1;             ///< first row in ConstraintData
   KVec rhs;                    ///< right side on the gravity-shifted acceleration
+};
+
+/// A joint-space row on the one velocity of a one-DoF joint, c q̇ + b = 0
+/// (a joint limit). It is not a loop: while closed it locks its joint —
+/// q̈ = ρ is fixed, the joint's motion subspace is empty for this solve, and
+/// the row's force ℓ = Σ c λ is read off the joint's force balance
+///     sᵀ(IA a + pA) = τ + (K s)ᵀ μ + ℓ.
+/// Several closed rows on one joint are one row: ρ = Σ c r / Σ c², λ = c ℓ / Σ c²
+/// (their minimum-norm split; the rest of their right sides must vanish).
+struct JointRow {
+  int constraint = -1;
+  int row = -1;                ///< row within the constraint
+  int global = -1;             ///< row in ConstraintData
+  double c = 0;                ///< coefficient on q̇ (this solve)
+  double rhs = 0;              ///< right side on q̈ (or on Δq̇ for the impulse)
+  bool active = false;
 };
 
 /// A row closing a loop: two moving bodies, or given over v (joint space).
@@ -194,6 +210,16 @@ struct Node {
   KVec mnRho;
   KVec dnu;                               ///< δν of the replay
 
+  // Locked joint (JointRow): closed rows on this one-DoF joint's velocity.
+  bool locked = false;
+  double c2 = 0;                          ///< Σ c² of the closed rows
+  double rho = 0;                         ///< q̈ they fix (bias pass)
+  double ell = 0;                         ///< their force on q̈ (forward pass)
+  KVec gl;                                ///< K s: how the rows of K see q̈
+  KVec kps;                               ///< Kpass s
+  Vec6 Hs;                                ///< H s: the parent's share of s ρ
+  std::vector<JointRow> jrows;            ///< declared rows on this joint
+
   std::vector<Segment> groups;            ///< own blocks, then children
   std::vector<Compression> comp;          ///< sized groups.size() + 1
 };
@@ -240,6 +266,7 @@ struct TreeWorkspace {
   std::vector<Node> nodes;
   std::vector<TreeBlock> blocks;
   std::vector<LoopRow> loops;
+  std::vector<int> jrow_nodes;            ///< bodies with JointRows, ascending
   std::vector<std::string> names;         ///< constraint names, for messages
 
   // Solver scratch with compile-time maximum sizes.
@@ -253,6 +280,7 @@ struct TreeWorkspace {
   // Outputs of one pass.
   VecX vdot, lambda;
   int redundant = 0;
+  int last_redundant = 0;                 ///< of the last solve / projection (redundantRows())
   Failure failure;
   /// Compliance factors (tree_solver/soft.cpp): F' of a joint, F_d, F_k of a stack.
   Eigen::JacobiSVD<StackMat, Eigen::ColPivHouseholderQRPreconditioner> svd12;
@@ -323,6 +351,22 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
 /// `impulse`, the velocity projection.
 void loopTargets(const Model& model, const Data& data, const ConstraintData& cdata,
                  TreeWorkspace& ws, const VecX& v, bool impulse);
+
+// Locked joints (tree_solver/locked.cpp).
+/// A joint with no free direction, for splitSoft/softBias/softForward of a
+/// locked node.
+const Joint& lockedJoint();
+/// Factor pass of a locked node (after its rows are compressed): all rows go
+/// up (hard) or as splitSoft decides (compliant); H for the parent.
+void splitLocked(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& H);
+/// ρ of a locked node's closed rows; false (ws.failure, ws.last_error) when
+/// their right sides disagree.
+bool lockedRhs(TreeWorkspace& ws, int body, bool check);
+/// ℓ of a locked node, from its joint's force balance (mu: the last
+/// compression's multipliers, on K), written as λ of its rows into `lambda`.
+void lockedForce(const Joint& j, Node& nd, double tau, VecX& lambda);
+/// Certificate share of a locked node's rows: ℓ = −(K s)ᵀ μ.
+void lockedCertificate(Node& nd, VecX& cert);
 
 // Compliant rows (tree_solver/soft.cpp).
 /// After compress(): the stack's compliance factor carried through Q, the
