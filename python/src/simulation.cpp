@@ -114,26 +114,7 @@ void Simulation::rowResiduals(VecX& residual, VecX& gap) {
   const VecX& q = sim_->q();
   const VecX& v = sim_->v();
   evaluateConstraintRows(s.model, *data_, s.constraints, *cdata_, sim_->time(), q, v);
-  residual.resize(cdata_->m);
-  for (size_t k = 0; k < s.constraints.size(); ++k) {
-    const Constraint& c = *s.constraints[k];
-    const RowBlock& blk = cdata_->blocks[k];
-    const int o = cdata_->offset[k];
-    if (c.jointSpace()) {
-      for (int i = 0; i < c.rows(); ++i) residual[o + i] = jointRowDot(blk, i, v) + cdata_->b[o + i];
-      continue;
-    }
-    // wₐ·Vₐ − w_b·V_b + b with world-frame body velocities (constraint.hpp).
-    const int a = c.bodyA(), b = c.bodyB();
-    const Vec6 Va = a >= 0 ? Vec6(data_->oMi[a].act(data_->v[a])) : Vec6::Zero();
-    const Vec6 Vb = b >= 0 ? Vec6(data_->oMi[b].act(data_->v[b])) : Vec6::Zero();
-    for (int i = 0; i < c.rows(); ++i) {
-      double value = cdata_->b[o + i];
-      if (a >= 0) value += blk.Wa.row(i).dot(Va);
-      if (b >= 0) value -= blk.Wb.row(i).dot(Vb);
-      residual[o + i] = value;
-    }
-  }
+  velocityResiduals(*data_, s.constraints, *cdata_, v, residual);
   gap = cdata_->gap;
 }
 

@@ -105,6 +105,10 @@ void evaluateConstraints(const Model& model, Data& data, const ConstraintList& c
 /// at (q, v) leaves it). O(m); A is not needed.
 double velocityResidual(const Data& data, const ConstraintList& constraints,
                         const ConstraintData& cdata, const VecX& v);
+/// Row by row, A v + b (size m; an open constraint's rows are its zero rows,
+/// so their b): the same O(m) reading of the rows, `data` as above.
+void velocityResiduals(const Data& data, const ConstraintList& constraints,
+                       const ConstraintData& cdata, const VecX& v, VecX& residual);
 /// The same at any v: recomputes forwardKinematics(q, v) into `data` first.
 double velocityResidual(const Model& model, Data& data, const ConstraintList& constraints,
                         const ConstraintData& cdata, const VecX& q, const VecX& v);

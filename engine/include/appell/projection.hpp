@@ -26,6 +26,8 @@
 
 namespace appell {
 
+class TreeSolver;
+
 struct ProjectionOptions {
   double gap_tol = 1e-12;   ///< stop when max |g| ≤ gap_tol (holonomic rows)
   /// Newton stalls at round-off on large coordinates: accept a residual below
@@ -48,8 +50,11 @@ struct PositionProjectionResult {
 /// project() does not allocate).
 class PositionProjector {
  public:
+  /// Each Newton step is a tree solver's velocity projection (O(n)): its
+  /// own, or `shared` — a TreeSolver built for the same model and
+  /// constraints (the simulator's), which saves a second workspace.
   PositionProjector(const Model& model, const ConstraintList& constraints,
-                    const ProjectionOptions& options = {});
+                    const ProjectionOptions& options = {}, TreeSolver* shared = nullptr);
   ~PositionProjector();
   PositionProjector(PositionProjector&&) noexcept;
   PositionProjector& operator=(PositionProjector&&) noexcept;

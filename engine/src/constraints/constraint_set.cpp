@@ -182,17 +182,19 @@ void evaluateConstraints(const Model& model, Data& data, const ConstraintList& c
   assembleDenseRows(model, data, constraints, cd);
 }
 
-double velocityResidual(const Data& data, const ConstraintList& constraints,
-                        const ConstraintData& cd, const VecX& v) {
-  double r = 0;  // row by row: no temporary vector
+namespace {
+
+/// Calls row(global index, A v + b) for each row of the closed constraints.
+template <typename F>
+void forEachRowResidual(const Data& data, const ConstraintList& constraints,
+                        const ConstraintData& cd, const VecX& v, F&& row) {
   for (size_t k = 0; k < constraints.size(); ++k) {
     const Constraint& c = *constraints[k];
     const RowBlock& blk = cd.blocks[k];
     const int o = cd.offset[k], m = c.rows();
     if (!cd.isActive(static_cast<int>(k))) continue;
     if (c.jointSpace()) {
-      for (int i = 0; i < m; ++i)
-        r = std::max(r, std::abs(jointRowDot(blk, i, v) + cd.b[o + i]));
+      for (int i = 0; i < m; ++i) row(o + i, jointRowDot(blk, i, v) + cd.b[o + i]);
       continue;
     }
     // wₐ·Vₐ − w_b·V_b + b with world-frame body velocities V = ᵒX V^body.
@@ -203,10 +205,25 @@ double velocityResidual(const Data& data, const ConstraintList& constraints,
       double value = cd.b[o + i];
       if (a >= 0) value += blk.Wa.row(i).dot(Va);
       if (bb >= 0) value -= blk.Wb.row(i).dot(Vb);
-      r = std::max(r, std::abs(value));
+      row(o + i, value);
     }
   }
+}
+
+}  // namespace
+
+double velocityResidual(const Data& data, const ConstraintList& constraints,
+                        const ConstraintData& cd, const VecX& v) {
+  double r = 0;  // row by row: no temporary vector
+  forEachRowResidual(data, constraints, cd, v,
+                     [&](int, double value) { r = std::max(r, std::abs(value)); });
   return r;
+}
+
+void velocityResiduals(const Data& data, const ConstraintList& constraints,
+                       const ConstraintData& cd, const VecX& v, VecX& residual) {
+  residual = cd.b;  // open constraints: zero rows
+  forEachRowResidual(data, constraints, cd, v, [&](int i, double value) { residual[i] = value; });
 }
 
 double velocityResidual(const Model& model, Data& data, const ConstraintList& constraints,

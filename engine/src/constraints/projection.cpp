@@ -2,6 +2,8 @@
 #include <appell/dynamics.hpp>
 #include <appell/projection.hpp>
 
+#include <appell/tree_solver.hpp>
+
 #include "solvers/row_basis.hpp"
 
 #include <algorithm>
@@ -12,15 +14,13 @@
 namespace appell {
 
 struct PositionProjector::Impl {
-  Impl(const Model& model, const ConstraintList& constraints, const ProjectionOptions& o)
-      : opt(o), mh(countHolonomic(constraints)), nd(mh > 0 ? model.nv : 0), llt(nd),
-        basis(nd, mh), Ah(MatX::Zero(mh, nd)), B(MatX::Zero(nd, mh)), J(MatX::Zero(6, nd)),
-        g(VecX::Zero(mh)),
-        y(VecX::Zero(model.nv)), theta(VecX::Zero(model.nv)), v0(VecX::Zero(model.nv)),
-        q_start(VecX::Zero(model.nq)), q_next(VecX::Zero(model.nq)) {
+  Impl(const Model& model, const ConstraintList& constraints, const ProjectionOptions& o,
+       TreeSolver* shared)
+      : opt(o), mh(countHolonomic(constraints)), y(VecX::Zero(model.nv)),
+        theta(VecX::Zero(model.nv)), v0(VecX::Zero(model.nv)), q_start(VecX::Zero(model.nq)),
+        q_next(VecX::Zero(model.nq)) {
     if (!(o.gap_tol > 0) || o.max_iterations < 1)
       throw std::invalid_argument("ProjectionOptions: gap_tol must be > 0 and max_iterations >= 1");
-    int rows_max = 0;
     for (size_t k = 0; k < constraints.size(); ++k) {
       const Constraint& c = *constraints[k];
       bool any = false;
@@ -28,35 +28,86 @@ struct PositionProjector::Impl {
         holonomic_flags.push_back(c.holonomic(r));
         any = any || c.holonomic(r);
       }
-      if (any) {
-        with_gaps.push_back(static_cast<int>(k));
-        rows_max = std::max(rows_max, c.rows());
-      }
+      has_gap.push_back(any ? 1 : 0);
+      if (any) with_gaps.push_back(static_cast<int>(k));
     }
     for (int i = 0; i < static_cast<int>(holonomic_flags.size()); ++i)
       if (holonomic_flags[i]) row_map.push_back(i);
-    Ak = MatX::Zero(rows_max, nd);
-    abias_k = VecX::Zero(rows_max);
+    g = VecX::Zero(mh);
+    if (mh > 0) {
+      rows = std::make_unique<ConstraintData>(model, constraints, DenseRows::None);
+      if (!shared) own = std::make_unique<TreeSolver>(model, constraints, o.rank);
+      tree = shared ? shared : own.get();
+      impulse = VecX::Zero(rows->m);
+    }
   }
 
-  /// A_hol: the holonomic rows of the dense form, assembled constraint by
-  /// constraint from the rows (only the constraints that have a gap).
-  void assembleHolonomicRows(const Model& model, const Data& data,
-                             const ConstraintList& constraints, const ConstraintData& cdata) {
+  /// The holonomic rows of cdata as a constraint set of their own: rows
+  /// that are not holonomic, and constraints that are open or have no gap,
+  /// write zero rows; b of a holonomic row is its gap, so the velocity
+  /// projection of v = 0 is the Newton step A_hol δ = −g.
+  void holonomicRows(const ConstraintList& constraints, const ConstraintData& cdata) {
+    ConstraintData& h = *rows;
+    h.singular = false;
+    for (size_t k = 0; k < constraints.size(); ++k) {
+      const int c = static_cast<int>(k);
+      const bool use = has_gap[c] && cdata.isActive(c);
+      h.setActive(c, use);
+      if (!use) continue;
+      const Constraint& con = *constraints[c];
+      const RowBlock& in = cdata.blocks[c];
+      RowBlock& out = h.blocks[c];
+      const int o = cdata.offset[c], m = con.rows();
+      if (con.jointSpace()) {
+        out.A_joint = in.A_joint;  // same size: no allocation
+        for (int r = 0; r < m; ++r) {
+          const bool hol = holonomic_flags[o + r];
+          if (!hol) out.A_joint.row(r).setZero();
+          out.b_joint[r] = hol ? cdata.gap[o + r] : 0.0;
+        }
+        continue;
+      }
+      out.Wa = in.Wa;
+      out.Wb = in.Wb;
+      for (int r = 0; r < m; ++r) {
+        const bool hol = holonomic_flags[o + r];
+        if (!hol) {
+          out.Wa.row(r).setZero();
+          out.Wb.row(r).setZero();
+        }
+        out.b[r] = hol ? cdata.gap[o + r] : 0.0;
+      }
+    }
+  }
+
+  /// Of the holonomic rows at q, how close the kept ones are to dependent
+  /// (the weakest pivot of their mass-metric QR) and which row that is — the
+  /// root cause to name when Newton stalls. Dense (O(m n²)), so only on that
+  /// failure and only for models small enough to afford it; −1 otherwise.
+  double weakestRow(const Model& model, Data& data, const ConstraintList& constraints,
+                    const ConstraintData& cdata, const VecX& q, int& row) const {
+    row = -1;
+    if (model.nv > kDenseDiagnosisMaxNv) return -1;
+    MatX Ah = MatX::Zero(mh, model.nv), J = MatX::Zero(6, model.nv);
     int k = 0;
     for (int c : with_gaps) {
       const Constraint& con = *constraints[c];
       const int o = cdata.offset[c], m = con.rows();
-      if (!cdata.isActive(c)) {  // an open contact: its gap is a clearance, not a constraint
-        for (int r = 0; r < m; ++r)
-          if (holonomic_flags[o + r]) Ah.row(k++).setZero();
-        continue;
-      }
-      assembleConstraintRows(model, data, con, cdata.blocks[c], J, Ak.topRows(m),
-                             abias_k.head(m));
+      MatX Ak = MatX::Zero(m, model.nv);
+      VecX ab = VecX::Zero(m);
+      if (cdata.isActive(c)) assembleConstraintRows(model, data, con, cdata.blocks[c], J, Ak, ab);
       for (int r = 0; r < m; ++r)
         if (holonomic_flags[o + r]) Ah.row(k++) = Ak.row(r);
     }
+    const Eigen::LLT<MatX> llt(crba(model, data, q));
+    if (llt.info() != Eigen::Success) return -1;
+    MatX B = Ah.transpose();
+    llt.matrixL().solveInPlace(B);
+    detail::RowBasis basis(model.nv, mh);
+    basis.factor(B, opt.rank, /*form_q=*/false);
+    if (basis.rank() == 0) return -1;
+    row = row_map[basis.pivot(basis.rank() - 1)];
+    return basis.weakestPivotRatio();
   }
 
   static int countHolonomic(const ConstraintList& constraints) {
@@ -68,22 +119,23 @@ struct PositionProjector::Impl {
     return n;
   }
 
+  /// Largest model the stall diagnosis factors densely.
+  static constexpr int kDenseDiagnosisMaxNv = 2000;
+
   ProjectionOptions opt;
   int mh;
-  int nd;  // columns of the dense storage: nv, or 0 when there is nothing to project
-           // (no nv × nv mass matrix for a model without holonomic rows)
-  Eigen::LLT<MatX> llt;
-  detail::RowBasis basis;
-  MatX Ah, B, J, Ak;
-  VecX g, y, theta, v0, q_start, q_next, abias_k;
-  std::vector<char> holonomic_flags;
+  std::unique_ptr<ConstraintData> rows;  // the holonomic rows alone (holonomicRows)
+  std::unique_ptr<TreeSolver> own;       // the O(n) mass-metric projection of each step,
+  TreeSolver* tree = nullptr;            // own or shared
+  VecX g, y, theta, v0, q_start, q_next, impulse;
+  std::vector<char> holonomic_flags, has_gap;
   std::vector<int> row_map;    // holonomic row → row of the system
   std::vector<int> with_gaps;  // constraints with at least one holonomic row
 };
 
 PositionProjector::PositionProjector(const Model& model, const ConstraintList& constraints,
-                                     const ProjectionOptions& options)
-    : impl_(std::make_unique<Impl>(model, constraints, options)) {}
+                                     const ProjectionOptions& options, TreeSolver* shared)
+    : impl_(std::make_unique<Impl>(model, constraints, options, shared)) {}
 PositionProjector::~PositionProjector() = default;
 PositionProjector::PositionProjector(PositionProjector&&) noexcept = default;
 PositionProjector& PositionProjector::operator=(PositionProjector&&) noexcept = default;
@@ -131,9 +183,9 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
       // Newton stalls where the rows it solves are close to dependent: say
       // so, naming the weakest row — the root cause (a wheel nearly flat, a
       // linkage near a dead point), not the symptom.
-      const double ratio = w.basis.weakestPivotRatio();
-      if (it > 0 && ratio < 1e-4) {
-        const int row = w.row_map[w.basis.pivot(w.basis.rank() - 1)];
+      int row = -1;
+      const double ratio = it > 0 ? w.weakestRow(model, data, constraints, cdata, q, row) : -1;
+      if (row >= 0 && ratio < 1e-4) {
         const int c = cdata.row_constraint[row];
         os << ": the constraint geometry is close to singular there — the holonomic rows are "
               "nearly dependent (pivot ratio "
@@ -157,19 +209,15 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
       return fail(os.str());
     }
     prev = gmax;
-    // Least-M-norm Newton step: A_hol δ = −g,  δ = L⁻ᵀ y,  (A_hol L⁻ᵀ) y = −g.
-    w.assembleHolonomicRows(model, data, constraints, cdata);  // before crba reuses data
-    w.llt.compute(crba(model, data, q));
-    if (w.llt.info() != Eigen::Success) return fail("mass matrix is not positive definite");
-    w.B = w.Ah.transpose();
-    w.llt.matrixL().solveInPlace(w.B);
-    w.basis.factor(w.B, w.opt.rank, /*form_q=*/false);
-    res.rank = w.basis.rank();
-    w.g = -w.g;
-    if (!w.basis.solveRows(w.g, w.y))
-      return fail("holonomic gaps cannot be closed: " +
-                  w.basis.describeInconsistency(constraints, cdata, &w.row_map));
-    w.llt.matrixU().solveInPlace(w.y);
+    // Least-M-norm Newton step A_hol δ = −g: the velocity projection of
+    // v = 0 onto the holonomic rows with their gaps as b — the tree solver's,
+    // O(n) and rank-aware (redundant gap rows are fine, contradictory ones
+    // an error naming them).
+    w.holonomicRows(constraints, cdata);
+    w.y.setZero();
+    if (!w.tree->projectVelocity(model, data, constraints, *w.rows, q, w.y, w.impulse))
+      return fail("holonomic gaps cannot be closed: " + w.tree->lastError());
+    res.rank = w.rows->m_active - w.tree->redundantRows();
     localRate(model, q, w.v0, w.y, w.theta);  // θ = T(q, 0) δ
     retract(model, q, w.theta, w.q_next);
     q = w.q_next;

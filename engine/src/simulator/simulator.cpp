@@ -1,6 +1,7 @@
 #include <appell/configuration.hpp>
 #include <appell/dynamics.hpp>
 #include <appell/simulator.hpp>
+#include <appell/tree_solver.hpp>
 
 #include "simulator/simulator_internal.hpp"
 
@@ -23,7 +24,10 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   // Dense storage (m × nv) only for the formulations that assemble A.
   cdata_ = std::make_unique<ConstraintData>(
       model_, constraints_, solver_->usesDenseRows() ? DenseRows::Sized : DenseRows::None);
-  projector_ = std::make_unique<PositionProjector>(model_, constraints_, options_.projection);
+  // The projection's Newton steps share the tree solver when the dynamics
+  // use one (one O(n) workspace, not two).
+  projector_ = std::make_unique<PositionProjector>(model_, constraints_, options_.projection,
+                                                   dynamic_cast<TreeSolver*>(solver_.get()));
   field_ = std::make_unique<Field>(*this);
   q_ = neutralConfiguration(model_);
   v_ = VecX::Zero(model_.nv);

@@ -19,9 +19,11 @@ struct Worst {
   bool gap = false;
 };
 
-Worst worstRow(const ConstraintData& cd, const VecX& v) {
+Worst worstRow(const Data& data, const ConstraintList& constraints, const ConstraintData& cd,
+               const VecX& v) {
   Worst w;
-  const VecX r = cd.A * v + cd.b;
+  VecX r;
+  velocityResiduals(data, constraints, cd, v, r);
   for (int i = 0; i < cd.m; ++i) {
     if (!cd.isActive(cd.row_constraint[i])) continue;  // open: its gap is a clearance
     if (std::abs(cd.gap(i)) > w.value) w = {std::abs(cd.gap(i)), i, true};
@@ -62,9 +64,10 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
     throw SceneError(scene.source + ": initial state is not finite");
   if (scene.constraints.empty()) return report;
 
-  Data data(model);
-  ConstraintData cd(model, scene.constraints);
-  evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
+  // Rows only, nothing dense: O(n) for a model of any size.
+  Data data(model, MassMatrix::None);
+  ConstraintData cd(model, scene.constraints, DenseRows::None);
+  evaluateConstraintRows(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
   // Contacts with clearance start open (as the simulator opens them): only
   // the closed ones must hold. A unilateral gap below −tol is penetration.
   for (int c = 0; c < static_cast<int>(scene.constraints.size()); ++c) {
@@ -81,7 +84,7 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
       throw SceneError(s.str());
     }
   }
-  evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
+  evaluateConstraintRows(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
   if (cd.singular) singular(scene, cd);
   report.velocity_residual = velocityResidual(data, scene.constraints, cd, scene.v0);
   report.gap_residual = gapResidual(cd);
@@ -89,7 +92,7 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
   if (report.velocity_residual <= tol && report.gap_residual <= tol) return report;
 
   if (!project) {
-    const Worst w = worstRow(cd, scene.v0);
+    const Worst w = worstRow(data, scene.constraints, cd, scene.v0);
     std::ostringstream s;
     s << scene.source << ": initial state violates the constraints: " << describeRow(scene, cd, w.row)
       << (w.gap ? " has gap " : " has velocity residual |A v + b| = ") << w.value
@@ -119,8 +122,8 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
   report.projected = true;
   if (!res.ok) {
     // q and v are unchanged: name the worst row at the initial state.
-    evaluateConstraints(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
-    const Worst w = worstRow(cd, scene.v0);
+    evaluateConstraintRows(model, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
+    const Worst w = worstRow(data, scene.constraints, cd, scene.v0);
     std::ostringstream s;
     s << scene.source << ": initial state could not be projected onto the constraints: "
       << res.error << " (worst: " << describeRow(scene, cd, w.row)
@@ -128,13 +131,13 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
       << ") after " << report.iterations << " Newton steps";
     throw SceneError(s.str());
   }
-  evaluateConstraints(model, data, scene.constraints, cd, 0.0, q, v);
+  evaluateConstraintRows(model, data, scene.constraints, cd, 0.0, q, v);
   if (cd.singular) singular(scene, cd);
   report.velocity_residual = velocityResidual(data, scene.constraints, cd, v);
   report.gap_residual = gapResidual(cd);
   notFinite(scene, report);
   if (report.velocity_residual > tol || report.gap_residual > tol) {
-    const Worst w = worstRow(cd, v);
+    const Worst w = worstRow(data, scene.constraints, cd, v);
     std::ostringstream s;
     s << scene.source << ": initial state could not be projected onto the constraints: "
       << describeRow(scene, cd, w.row) << (w.gap ? " keeps gap " : " keeps velocity residual ")
