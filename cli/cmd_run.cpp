@@ -94,7 +94,19 @@ class Progress {
 void printContacts(std::ostream& out, const RunSummary& r) {
   if (r.contacts.empty()) return;
   out << "contacts (over " << r.samples << " samples):\n";
+  // Constraints never closed (a joint limit the motion never reached) are
+  // one line, not one each: a robot has two limits per joint.
+  auto never_closed = [](const ContactStats& e) {
+    return e.normal_row >= 0 && !e.normal_held && e.min_normal > e.max_normal;
+  };
+  int open = 0;
+  std::string open_names;
   for (const ContactStats& e : r.contacts) {
+    if (!never_closed(e)) continue;
+    if (++open <= 4) open_names += (open_names.empty() ? "" : ", ") + e.name;
+  }
+  for (const ContactStats& e : r.contacts) {
+    if (never_closed(e)) continue;
     out << "  " << std::left << std::setw(24) << e.name << std::right;
     if (e.normal_row < 0) {
       if (e.reaction_row >= 0 && e.min_reaction <= e.max_reaction)
@@ -106,10 +118,6 @@ void printContacts(std::ostream& out, const RunSummary& r) {
     }
     if (e.normal_held) {
       out << " normal held by the joints (its row moves nothing: redundant by construction)\n";
-      continue;
-    }
-    if (e.min_normal > e.max_normal) {  // no closed sample
-      out << " open throughout (" << e.open_samples << " samples)\n";
       continue;
     }
     out << std::setprecision(4) << " normal load " << e.min_normal << " … " << e.max_normal << " N";
@@ -125,6 +133,9 @@ void printContacts(std::ostream& out, const RunSummary& r) {
     if (e.open_samples) out << "; open in " << e.open_samples << " samples";
     out << "\n";
   }
+  if (open > 0)
+    out << "  open throughout: " << open << (open == 1 ? " constraint (" : " constraints (")
+        << open_names << (open > 4 ? ", …" : "") << ")\n";
 }
 
 // One line per contact event (at most the first 50, then a count).
@@ -154,7 +165,10 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
   const bool adaptive = o.integrator == IntegratorType::DormandPrince54;
   out << std::setprecision(6) << "scene        " << scene.source << "\n"
       << "model        " << scene.model.nbodies << " bodies, nv = " << scene.model.nv << ", "
-      << scene.constraints.size() << " contacts, " << scene.constraintRows() << " rows\n"
+      << scene.contacts.size() << " contacts, ";
+  if (!scene.joint_limits.empty()) out << scene.joint_limits.size() << " joint limits, ";
+  if (!scene.couplings.empty()) out << scene.couplings.size() << " mimic couplings, ";
+  out << scene.constraintRows() << " rows\n"
       << "method       " << toString(o.integrator) << (adaptive ? " (tol " : " (dt ")
       << (adaptive ? o.tol : o.dt) << "), formulation " << toString(o.formulation) << "\n"
       << "simulated    " << r.time << " s in " << c.steps << " steps";

@@ -32,8 +32,10 @@ constexpr bool kSanitized = false;
 #endif
 
 /// A chain of n links on continuous joints about y, each hanging 0.1 m
-/// below its parent; the first link's joint to the world is floating.
-std::string chainUrdf(int n) {
+/// below its parent; the first link's joint to the world is floating. With
+/// `limits`, revolute joints limited to [0, 1] rad: every joint starts at its
+/// lower limit, so all 2n limits are declared and n of them start closed.
+std::string chainUrdf(int n, bool limits = false) {
   std::ostringstream u;
   u << "<robot name=\"chain\">\n";
   const char* inertial =
@@ -41,8 +43,11 @@ std::string chainUrdf(int n) {
       "ixz=\"0\" iyz=\"0\"/></inertial>";
   for (int i = 0; i <= n; ++i) u << "<link name=\"l" << i << "\">" << inertial << "</link>\n";
   for (int i = 0; i < n; ++i)
-    u << "<joint name=\"j" << i << "\" type=\"continuous\"><parent link=\"l" << i
-      << "\"/><child link=\"l" << i + 1 << "\"/><origin xyz=\"0 0 -0.1\"/><axis xyz=\"0 1 0\"/></joint>\n";
+    u << "<joint name=\"j" << i << "\" type=\"" << (limits ? "revolute" : "continuous")
+      << "\"><parent link=\"l" << i << "\"/><child link=\"l" << i + 1
+      << "\"/><origin xyz=\"0 0 -0.1\"/><axis xyz=\"0 1 0\"/>"
+      << (limits ? "<limit lower=\"0\" upper=\"1\" effort=\"10\" velocity=\"1\"/>" : "")
+      << "</joint>\n";
   u << "</robot>\n";
   return u.str();
 }
@@ -57,13 +62,14 @@ struct Measured {
   double max_joint_rate = 0, root_speed_error = 0;
 };
 
-Measured loadAndStep(int n) {
+Measured loadAndStep(int n, bool limits = false) {
   Measured out;
-  const std::string xml = chainUrdf(n);
+  const std::string xml = chainUrdf(n, limits);
   const std::size_t before = bytesInUse();
   {
     const Scene scene = loadSceneFromString(xml, ".");
     EXPECT_EQ(scene.model.nbodies, n + 1);
+    EXPECT_EQ(static_cast<int>(scene.joint_limits.size()), limits ? 2 * n : 0);
     RunOptions options = runOptions(scene.settings);
     options.formulation = Formulation::Tree;
     options.integrator = IntegratorType::RK4;
@@ -94,6 +100,25 @@ TEST(LargeModels, ChainOf100000LinksLoadsAndStepsInLinearMemory) {
   ASSERT_GT(small.bytes, 0u);
   const double growth = static_cast<double>(large.bytes) / static_cast<double>(small.bytes);
   // 10× the links: ~10× the memory (a dense nv × nv matrix would be 100×).
+  RecordProperty("bytes_per_body", static_cast<int>(large.bytes / 100000));
+  EXPECT_LT(growth, 12.0) << small.bytes << " → " << large.bytes << " bytes";
+  EXPECT_LT(large.bytes / 100000.0, 64.0 * 1024) << "bytes per body";
+}
+
+// Protects: joint limits keep it O(n) — the rows are sparse (one column
+// each), a closed limit locks its joint inside the tree solver's passes
+// (no loop rows, no k × n workspace), and the position projection's Newton
+// step is the tree solver's, not a dense factorization. 2·10⁵ limits, 10⁵ of
+// them closed at the start; the chain falls as one body.
+TEST(LargeModels, ChainOf100000LimitedJointsLoadsAndStepsInLinearMemory) {
+  if (kSanitized) GTEST_SKIP() << "mallinfo2 does not see a sanitizer's allocator";
+  const Measured small = loadAndStep(10000, true), large = loadAndStep(100000, true);
+  for (const Measured* r : {&small, &large}) {
+    EXPECT_LT(r->max_joint_rate, 1e-9);
+    EXPECT_LT(r->root_speed_error, 1e-12);
+  }
+  ASSERT_GT(small.bytes, 0u);
+  const double growth = static_cast<double>(large.bytes) / static_cast<double>(small.bytes);
   RecordProperty("bytes_per_body", static_cast<int>(large.bytes / 100000));
   EXPECT_LT(growth, 12.0) << small.bytes << " → " << large.bytes << " bytes";
   EXPECT_LT(large.bytes / 100000.0, 64.0 * 1024) << "bytes per body";

@@ -8,6 +8,7 @@
 #include <appell/constraint_set.hpp>
 #include <appell/kinematics.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace appell::run_detail {
@@ -39,22 +40,34 @@ void markHeldNormals(std::vector<ContactStats>& stats, const Scene& scene, const
   Data data(model, MassMatrix::None);
   forwardKinematics(model, data, sim.q(), sim.v());
   const ConstraintData& cd = sim.constraintData();
-  MatX J(6, model.nv), A;
+  MatX J, A;
   VecX abias;
   for (std::size_t k = 0; k < stats.size() && k < scene.constraints.size(); ++k) {
     ContactStats& e = stats[k];
-    if (e.normal_row < 0) continue;
+    // An open constraint's block holds zero rows: nothing to judge from them.
+    if (e.normal_row < 0 || !cd.isActive(static_cast<int>(k))) continue;
     const Constraint& c = *scene.constraints[k];
+    const int r = e.normal_row - cd.offset[k];
+    if (c.jointSpace()) {  // its own sparse row (a joint limit: ±1 on its joint)
+      const auto row = cd.blocks[k].A_joint.row(r);
+      e.normal_held = row.size() == 0 || row.lpNorm<Eigen::Infinity>() <= 1e-12 *
+                          std::max(1.0, cd.blocks[k].A_joint.lpNorm<Eigen::Infinity>());
+      continue;
+    }
+    if (J.cols() != model.nv) J.resize(6, model.nv);
     A.resize(c.rows(), model.nv);
     abias.resize(c.rows());
     assembleConstraintRows(model, data, c, cd.blocks[k], J, A, abias);
-    const int r = e.normal_row - cd.offset[k];
     e.normal_held = A.row(r).lpNorm<Eigen::Infinity>() <= 1e-12 * std::max(1.0, A.lpNorm<Eigen::Infinity>());
   }
 }
 
 void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
             const ConstraintData& cdata) {
+  // A closed contact at zero load (a limit in free fall, a wheel at the
+  // instant of lift-off) neither pulls nor has a friction demand: loads
+  // within round-off of the sample's largest reaction count as zero.
+  const double zero = 1e-9 * std::max(1.0, lambda.size() ? lambda.lpNorm<Eigen::Infinity>() : 0.0);
   for (ContactStats& e : stats) {
     if (e.reaction_row >= 0) {
       e.min_reaction = std::min(e.min_reaction, lambda[e.reaction_row]);
@@ -72,10 +85,11 @@ void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
     e.min_normal = std::min(e.min_normal, fn);
     e.max_normal = std::max(e.max_normal, fn);
     if (e.normal_held) continue;  // the joints carry the normal: no load to judge
-    if (fn <= 0) {  // a bilateral contact pulling, or a unilateral one at lift-off
+    if (fn < -zero) {  // a bilateral contact pulling, or a unilateral one at lift-off
       if (e.pulling++ == 0) e.first_pull = t;
       continue;
     }
+    if (fn <= zero) continue;  // no load: nothing pulls, no friction to judge
     const double demand = ft / fn;
     if (demand > e.max_demand) {
       e.max_demand = demand;
