@@ -257,3 +257,34 @@ TEST(Run, AHugeJointForceIsNamedAsTheCauseOfTheFailure) {
   const RunSummary fine = runScene(withEffort("1"), o);
   EXPECT_TRUE(fine.ok) << fine.failure;
 }
+
+// Protects: a fixed-step run that fails because its step left RK4's
+// stability region names that as the cause, with a step that would hold.
+// The sleigh sliding down its incline speeds up, and its yaw mode's decay
+// rate grows with the speed (λ ≈ −1.67 V /s here): with dt = 0.02 s, λ·dt
+// passes RK4's real-axis limit 2.785 near t = 31 s and the energy watch stops
+// the run. The message gives the mode and a dt that keeps it stable — which
+// then runs well past that time — while a mode that grows physically
+// (Re λ > 0) is never blamed on the step.
+TEST(Run, AStepBeyondRk4sStabilityRegionIsNamedAsTheCause) {
+  const Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/sleigh/sleigh.urdf");
+  RunOptions o = runOptions(scene.settings);
+  o.integrator = IntegratorType::RK4;
+  o.dt = 0.02;
+  o.duration = 60;
+  const RunSummary bad = runScene(scene, o, {});
+  ASSERT_FALSE(bad.ok);
+  EXPECT_GT(bad.time, 25.0);
+  EXPECT_LT(bad.time, 40.0);
+  EXPECT_NE(bad.failure.find("outside RK4's stability region"), std::string::npos) << bad.failure;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(bad.failure, m, std::regex("dt ≤ ([0-9.e+-]+) s"))) << bad.failure;
+  const double suggested = std::stod(m[1]);
+  EXPECT_LT(suggested, o.dt);
+  EXPECT_GT(suggested, 0.5 * o.dt);
+  o.dt = suggested;
+  o.duration = bad.time + 5;
+  const RunSummary good = runScene(scene, o, {});
+  EXPECT_TRUE(good.ok) << good.failure;
+  EXPECT_LT(good.max_energy_deviation, 1e-6 * std::abs(good.energy_scale));
+}

@@ -1,5 +1,6 @@
 // The run loop and its summary (run.hpp).
 #include "contact_stats.hpp"
+#include "step_stability.hpp"
 #include "vertex_watch.hpp"
 
 #include <algorithm>
@@ -175,7 +176,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
     if (!status.ok) {
       s.ok = false;
-      s.failure = status.message + forceMagnitudeCause(scene, sim);
+      s.failure = status.message + forceMagnitudeCause(scene, sim) +
+                  run_detail::stepStabilityCause(scene, sim, options);
       break;
     }
     const double work_in = sim.jointWork() + sim.supportWork();
@@ -208,7 +210,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
         why << "at t = " << sim.time() << " s: " << uncovered;
       }
       s.ok = false;
-      s.failure = why.str();
+      s.failure = why.str() + run_detail::stepStabilityCause(scene, sim, options);
       const double impacts = sim.impactEnergyLoss(), friction = sim.frictionWork();
       const double joint = sim.jointWork(), support = sim.supportWork();
       sim.setState(t_good, q_good, v_good);  // (restarts the loss counters)
