@@ -88,21 +88,26 @@ Measured loadAndStep(int n, bool limits = false) {
   return out;
 }
 
-}  // namespace
-
-TEST(LargeModels, ChainOf100000LinksLoadsAndStepsInLinearMemory) {
-  if (kSanitized) GTEST_SKIP() << "mallinfo2 does not see a sanitizer's allocator";
-  const Measured small = loadAndStep(10000), large = loadAndStep(100000);
+/// Loads and steps chains of 10⁴ and 10⁵ links: both fall as one body, and
+/// 10× the links take ~10× the memory (a dense nv × nv matrix would be 100×).
+void expectLinearMemory(bool limits) {
+  const Measured small = loadAndStep(10000, limits), large = loadAndStep(100000, limits);
   for (const Measured* r : {&small, &large}) {
     EXPECT_LT(r->max_joint_rate, 1e-9);
     EXPECT_LT(r->root_speed_error, 1e-12);
   }
   ASSERT_GT(small.bytes, 0u);
   const double growth = static_cast<double>(large.bytes) / static_cast<double>(small.bytes);
-  // 10× the links: ~10× the memory (a dense nv × nv matrix would be 100×).
-  RecordProperty("bytes_per_body", static_cast<int>(large.bytes / 100000));
+  ::testing::Test::RecordProperty("bytes_per_body", static_cast<int>(large.bytes / 100000));
   EXPECT_LT(growth, 12.0) << small.bytes << " → " << large.bytes << " bytes";
   EXPECT_LT(large.bytes / 100000.0, 64.0 * 1024) << "bytes per body";
+}
+
+}  // namespace
+
+TEST(LargeModels, ChainOf100000LinksLoadsAndStepsInLinearMemory) {
+  if (kSanitized) GTEST_SKIP() << "mallinfo2 does not see a sanitizer's allocator";
+  expectLinearMemory(false);
 }
 
 // Protects: joint limits keep it O(n) — the rows are sparse (one column
@@ -112,14 +117,5 @@ TEST(LargeModels, ChainOf100000LinksLoadsAndStepsInLinearMemory) {
 // them closed at the start; the chain falls as one body.
 TEST(LargeModels, ChainOf100000LimitedJointsLoadsAndStepsInLinearMemory) {
   if (kSanitized) GTEST_SKIP() << "mallinfo2 does not see a sanitizer's allocator";
-  const Measured small = loadAndStep(10000, true), large = loadAndStep(100000, true);
-  for (const Measured* r : {&small, &large}) {
-    EXPECT_LT(r->max_joint_rate, 1e-9);
-    EXPECT_LT(r->root_speed_error, 1e-12);
-  }
-  ASSERT_GT(small.bytes, 0u);
-  const double growth = static_cast<double>(large.bytes) / static_cast<double>(small.bytes);
-  RecordProperty("bytes_per_body", static_cast<int>(large.bytes / 100000));
-  EXPECT_LT(growth, 12.0) << small.bytes << " → " << large.bytes << " bytes";
-  EXPECT_LT(large.bytes / 100000.0, 64.0 * 1024) << "bytes per body";
+  expectLinearMemory(true);
 }
