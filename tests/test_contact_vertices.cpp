@@ -265,7 +265,8 @@ TEST(ContactVertices, CylinderStandingOnItsFaceLandsOnItsRim) {
 // friction taking μ m g cos α per metre — Simulator::frictionWork() to the
 // trapezoidal rule's accuracy, and E + friction work conserved. The four
 // normal rows are redundant (a block has 3 freedoms off the plane): the
-// sliding solve must still find the loads.
+// sliding solve must still find the loads, and the onset of the slip must
+// give every corner its downhill direction at once.
 TEST(ContactVertices, BlockOnAnInclineSticksOrSlidesByTheFrictionAngle) {
   const double alpha = 0.4;  // tan α = 0.423
   const Vec3 n(-std::sin(alpha), 0, std::cos(alpha));
@@ -311,10 +312,12 @@ TEST(ContactVertices, BlockOnAnInclineSticksOrSlidesByTheFrictionAngle) {
       const double a = kG * (std::sin(alpha) - mu * std::cos(alpha));
       EXPECT_NEAR((-sim.v()[3] - v_half) / (sim.time() - t_half), a, 1e-9)
           << "slides at g (sin α − μ cos α)";
-      // Known defect (docs/contacts.md §8): just after the slip starts from
-      // rest the friction falls short, so the block runs 0.76 % further
-      // than ½ a t² by t = 1 s. Bounded here so that it cannot grow unseen.
-      EXPECT_NEAR(travelled, 0.5 * a, 0.01 * 0.5 * a);
+      // From the first instant: the four corners' slip directions are
+      // decided together (frictionOnset), all downhill — decided one at a
+      // time they carried lateral parts and the block ran 0.76 % too far.
+      EXPECT_NEAR(travelled, 0.5 * a * sim.time() * sim.time(), 1e-9)
+          << "½ a t² from t = 0";
+      EXPECT_LT(std::abs(sim.q()[1]), 1e-12) << "no sideways drift";
       EXPECT_NEAR(sim.frictionWork(), mu * kMass * kG * std::cos(alpha) * travelled, 1e-6)
           << "friction takes μ m g cos α per metre";
       EXPECT_LT(worst, 1e-6) << "E + friction work is conserved (trapezoidal rule)";

@@ -64,6 +64,7 @@ struct ConstraintData {
     Eigen::Matrix<double, 3, 6> Wa = Eigen::Matrix<double, 3, 6>::Zero();  ///< covectors on body A
     Eigen::Matrix<double, 3, 6> Wb = Eigen::Matrix<double, 3, 6>::Zero();  ///< and on body B
     Vec3 slip = Vec3::Zero();                ///< row values: the slip velocity along each
+    Vec3 kappa = Vec3::Zero();               ///< their κ: slip acceleration = Wa·aₐ − Wb·a_b + κ
   };
   std::vector<SlidingRows> slide;            ///< per constraint (n = 0: no friction rows)
   bool isSliding(int constraint) const { return sliding[constraint] != 0; }

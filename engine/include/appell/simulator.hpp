@@ -64,6 +64,9 @@ struct SimulatorCounters {
   long projection_iterations = 0;  ///< Newton iterations of the position projection
   long events = 0;                 ///< contact events (touchdown, bounce, lift-off)
   long event_steps = 0;            ///< extra steps taken to locate events
+  /// Friction onsets whose joint problem did not settle (its modes were then
+  /// decided one contact at a time: docs/contacts.md §8).
+  long friction_onset_unsettled = 0;
 };
 
 class Simulator {
@@ -157,7 +160,9 @@ class Simulator {
   int crossedConstraint(detail::Crossing& type) const;
   bool solveDynamics(double t, const VecX& q, const VecX& v, const VecX& tau,
                      ConstrainedResult& out, SolveOutputs outputs = SolveOutputs::All);
-  bool frictionPhase(std::string& error);
+  bool frictionPhase(std::string& error, int forced = -1);
+  bool frictionOnset(int forced, std::string& error);
+  Vec3 contactSlip(int k) const;
   Vec3 frictionForce(int k, const VecX& lambda) const;
   StepStatus locateAndHandleEvent(StepStatus st, double h);
   double eventFunction(int u, detail::Crossing type);

@@ -110,6 +110,7 @@ void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList
         const int r = sr.row[i];
         sr.Wa.row(i) = blk.Wa.row(r);
         sr.Wb.row(i) = blk.Wb.row(r);
+        sr.kappa[i] = blk.kappa[r];
         sr.slip[i] = blk.b[r] + (a >= 0 ? blk.Wa.row(r).dot(Va) : 0.0) -
                      (bb >= 0 ? blk.Wb.row(r).dot(Vb) : 0.0);
       }

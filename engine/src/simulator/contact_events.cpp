@@ -89,6 +89,18 @@ void Simulator::setUpUnilateral() {
   u.s = VecX::Zero(kf);
   u.tau_f = VecX::Zero(model_.nv);
   u.unit = u.res;
+  int nf = 0;
+  for (const auto& r : u.rows) nf += r.nf;
+  u.onset.reserve(u.rows.size());
+  u.was_sliding.assign(u.rows.size(), 0);
+  u.U = MatX::Zero(model_.nv, nf);
+  u.W = MatX::Zero(nf, nf);
+  u.N = MatX::Zero(kf, nf);
+  u.a0 = VecX::Zero(nf);
+  u.acc = VecX::Zero(nf);
+  u.f = VecX::Zero(nf);
+  u.f_old = VecX::Zero(nf);
+  u.ln0 = VecX::Zero(kf);
 }
 
 // ---------------------------------------------------------------- detection
@@ -304,7 +316,8 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
       cdata_->setSliding(ev.c, true);
       logEvent(ContactEventKind::Slip, k, 0, 0, 0);
     }
-    if (!frictionPhase(error)) return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+    if (!frictionPhase(error, type == detail::Crossing::Cone ? k : -1))
+      return fail(st, "at t = " + std::to_string(t_) + ": " + error);
     if (type == detail::Crossing::Slip && !cdata_->isSliding(ev.c))
       logEvent(ContactEventKind::Stick, k, 0, 0, 0);
   } else if (!decideModes(error) || !frictionPhase(error)) {
@@ -590,15 +603,19 @@ bool Simulator::forcePhase(std::string& error) {
   return true;
 }
 
-/// Friction modes at (t_, q_, v_), the normal modes decided: a closed
-/// contact that slips (an initial state sliding, or one whose impact left the
-/// cone) slides along its slip; a sticking one whose friction demand exceeds
-/// μ slides against its sticking force (−λₜ/|λₜ|: the friction it already
-/// exerts, at its limit); a sliding one at rest sticks if the cone allows.
-/// Repeated until no contact changes (each change moves the others' loads).
-bool Simulator::frictionPhase(std::string& error) {
+/// Friction modes at (t_, q_, v_), the normal modes decided. The contacts
+/// that are not slipping are decided together first (frictionOnset), when
+/// one of them needs a decision: a sticking one over its cone, a sliding one
+/// whose slip stopped, or `forced` (at its slip event). Then, until nothing
+/// changes (each change moves the others' loads): a closed contact that
+/// slips (an initial state sliding, or one whose impact left the cone)
+/// slides along its slip; a sticking one whose friction demand exceeds μ
+/// slides against its sticking force (−λₜ/|λₜ|: the friction it already
+/// exerts, at its limit).
+bool Simulator::frictionPhase(std::string& error, int forced) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
+  bool onset_done = false;
   for (int it = 0;; ++it) {
     if (it == o.max_mode_iterations) {
       error = "friction modes: no consistent stick/slip set after " + std::to_string(it) + " passes";
@@ -611,23 +628,27 @@ bool Simulator::frictionPhase(std::string& error) {
       error = "friction modes: " + u.res.error;
       return false;
     }
+    if (!onset_done) {
+      onset_done = true;
+      bool needed = forced >= 0;
+      for (int k = 0; k < static_cast<int>(u.rows.size()) && !needed; ++k) {
+        const UnilateralRow& r = u.rows[k];
+        if (r.nf == 0 || !cdata_->isActive(r.c) || contactSlip(k).norm() > o.speed_tol) continue;
+        needed = cdata_->isSliding(r.c) ||
+                 frictionForce(k, u.res.lambda).norm() > r.mu * u.res.lambda[r.global] + o.force_tol;
+      }
+      if (needed) {
+        if (!frictionOnset(forced, error)) return false;
+        continue;
+      }
+    }
     int change = -1;
     for (int k = 0; k < static_cast<int>(u.rows.size()) && change < 0; ++k) {
       UnilateralRow& r = u.rows[k];
-      if (r.nf == 0 || !cdata_->isActive(r.c)) continue;
+      if (r.nf == 0 || !cdata_->isActive(r.c) || cdata_->isSliding(r.c)) continue;
       const double fn = u.res.lambda[r.global];
-      if (cdata_->isSliding(r.c)) continue;
       // Sticking rows' residuals are the slip (before any projection).
-      const RowBlock& blk = cdata_->blocks[r.c];
-      const auto& sr = cdata_->slide[r.c];
-      Vec3 slip = Vec3::Zero();
-      for (int i = 0; i < sr.n; ++i) {
-        const int row = sr.row[i];
-        double val = blk.b[row];
-        if (r.a >= 0) val += blk.Wa.row(row).dot(data_->oMi[r.a].act(data_->v[r.a]));
-        if (r.b >= 0) val -= blk.Wb.row(row).dot(data_->oMi[r.b].act(data_->v[r.b]));
-        slip[i] = val;
-      }
+      const Vec3 slip = contactSlip(k);
       const Vec3 ft = frictionForce(k, u.res.lambda);
       if (slip.norm() > o.speed_tol) {
         r.dir = slip / slip.norm();

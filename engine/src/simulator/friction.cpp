@@ -49,7 +49,8 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
   if (u) {
     u->sliding.clear();  // capacity reserved: no allocation
     for (int k = 0; k < static_cast<int>(u->rows.size()); ++k)
-      if (cdata_->isActive(u->rows[k].c) && cdata_->isSliding(u->rows[k].c)) u->sliding.push_back(k);
+      if (cdata_->isActive(u->rows[k].c) && cdata_->isSliding(u->rows[k].c) && !u->rows[k].released)
+        u->sliding.push_back(k);
   }
   if (!u || u->sliding.empty()) {
     solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, outputs);

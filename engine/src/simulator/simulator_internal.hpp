@@ -97,6 +97,10 @@ struct UnilateralRow {
   int nf = 0;             // friction rows (0: frictionless or bilateral)
   Vec3 dir = Vec3::Zero();
   Vec3 dir_start = Vec3::Zero();  // at the step's start: the slip-reversal event's reference
+  // Friction released for frictionOnset: sliding without a friction force
+  // (its force is an unknown of the onset problem, not superposed).
+  bool released = false;
+  int first_force = 0;    // onset: index of its first friction row's unknown
 };
 
 /// What a unilateral constraint's crossing is (the event function located).
@@ -115,6 +119,14 @@ struct UnilateralState {
   VecX lam0, s, tau_f;
   ConstrainedResult unit;
   Eigen::PartialPivLU<MatX> lu;
+  // The onset problem (friction_onset.cpp), sized for every friction row:
+  // candidates, their generalized forces per unit row force (nv × F), the
+  // slip accelerations' and normal loads' responses W (F × F), N (K × F),
+  // the free terms, the forces and the modes before.
+  std::vector<int> onset;
+  MatX U, W, N;
+  VecX a0, ln0, f, acc, f_old;
+  std::vector<char> was_sliding;
 };
 
 }  // namespace detail

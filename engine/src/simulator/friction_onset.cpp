@@ -1,0 +1,264 @@
+// The friction modes of contacts that are not slipping, decided together.
+//
+// At an instant where K closed contacts with friction have zero slip (at
+// rest, at a stick event, at t = 0), whether each sticks or starts to slide
+// — and in which direction — is one problem, not K: a block on four corners
+// whose corners were made to slide one at a time, each against its own
+// sticking force, slid with directions that carried lateral parts (the
+// redundant corners' minimum-norm sticking forces), so too little friction
+// acted downhill until the slips themselves set the directions.
+//
+// With every friction row of the K contacts released (their forces fⱼ
+// unknown, their normal rows kept), the slip accelerations and the normal
+// loads are affine in the forces — one solve of the scene's formulation at
+// τ and one per unit row force (F + 1 solves for F friction rows, O(F n)
+// with the tree solver):
+//     ṡ = ṡ⁰ + W f,        λₙ = λₙ⁰ + N f,
+// W = Jₜ M⁻¹(1 − Aᵀ(A M⁻¹Aᵀ)⁺A M⁻¹) Jₜᵀ symmetric positive semidefinite (the
+// Delassus operator of the friction rows under the remaining constraints).
+// Each contact sticks,  ṡⱼ = 0 with |fⱼ| ≤ μⱼλₙⱼ,  or slides from rest along
+// its slip acceleration against its friction,  fⱼ = −μⱼλₙⱼ ṡⱼ/|ṡⱼ|  (Pfeiffer &
+// Glocker, "Multibody Dynamics with Unilateral Contacts", 1996, §7.3: the
+// tangential complementarity at the acceleration level). For given loads
+// these are the optimality conditions of
+//     min ½ fᵀW f + ṡ⁰ᵀf   over   |fⱼ| ≤ μⱼλₙⱼ
+// (maximal dissipation: Moreau 1988), solved by block Gauss–Seidel — each
+// contact's block, a disk in its 1–3 friction rows, exactly (the trust-region
+// secular equation) — the loads updated as it sweeps. A contact forced to
+// slide (at its located slip event the demand is exactly at the cone, and
+// rising) takes the circle |fⱼ| = μⱼλₙⱼ: its direction is decided with the
+// others.
+//
+// The result sets each candidate's mode and sliding direction; the friction
+// phase then checks the modes with the full rows (a sticking contact's spin
+// row, released here, is back) and slides any left over the cone one at a
+// time, as before.
+#include <appell/kinematics.hpp>
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_internal.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+
+namespace appell {
+
+using detail::UnilateralRow;
+
+namespace {
+
+/// argmin ½ fᵀH f + cᵀf over |f| ≤ r in the first n (≤ 3) components, H
+/// symmetric positive semidefinite: the unconstrained (minimum-norm)
+/// minimizer when it lies inside, else f = −(H + νI)⁻¹c with ν > 0 on the
+/// circle (bisection on the monotone |f(ν)|).
+Vec3 diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
+  if (!(r > 0)) return Vec3::Zero();
+  Mat3 Hp = Mat3::Identity();
+  Hp.topLeftCorner(n, n) = H.topLeftCorner(n, n);
+  Vec3 cp = Vec3::Zero();
+  cp.head(n) = c.head(n);
+  Eigen::SelfAdjointEigenSolver<Mat3> es(Hp);
+  const Vec3 lam = es.eigenvalues().cwiseMax(0.0);
+  const Vec3 cq = es.eigenvectors().transpose() * cp;
+  const double tiny = 1e-12 * std::max(lam.maxCoeff(), 1e-300);
+  // The minimum-norm unconstrained minimizer exists when c has no part in
+  // H's null space.
+  bool bounded = true;
+  Vec3 fq = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (lam[i] > tiny) fq[i] = -cq[i] / lam[i];
+    else if (std::abs(cq[i]) > 1e-14 * (cq.norm() + 1e-300)) bounded = false;
+  }
+  if (bounded && fq.norm() <= r) {
+    Vec3 f = es.eigenvectors() * fq;
+    f.tail(3 - n).setZero();
+    return f;
+  }
+  auto radius = [&](double nu) {
+    double s = 0;
+    for (int i = 0; i < 3; ++i) s += cq[i] * cq[i] / ((lam[i] + nu) * (lam[i] + nu));
+    return std::sqrt(s);
+  };
+  double lo = 0, hi = cq.norm() / r;  // |f(hi)| ≤ |c| / hi = r
+  for (int it = 0; it < 200 && hi - lo > 1e-16 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (radius(mid) > r ? lo : hi) = mid;
+  }
+  for (int i = 0; i < 3; ++i) fq[i] = -cq[i] / (lam[i] + hi);
+  Vec3 f = es.eigenvectors() * fq;
+  f.tail(3 - n).setZero();
+  return f;
+}
+
+}  // namespace
+
+/// The slip velocity of unilateral row k's friction rows at data_'s
+/// velocities (a sliding contact's as evaluated; a sticking one's from its
+/// rows, before any projection).
+Vec3 Simulator::contactSlip(int k) const {
+  const UnilateralRow& r = uni_->rows[k];
+  const auto& sr = cdata_->slide[r.c];
+  if (cdata_->isSliding(r.c)) return sr.slip;
+  const RowBlock& blk = cdata_->blocks[r.c];
+  Vec3 slip = Vec3::Zero();
+  for (int i = 0; i < sr.n; ++i) {
+    const int row = sr.row[i];
+    double val = blk.b[row];
+    if (r.a >= 0) val += blk.Wa.row(row).dot(data_->oMi[r.a].act(data_->v[r.a]));
+    if (r.b >= 0) val -= blk.Wb.row(row).dot(data_->oMi[r.b].act(data_->v[r.b]));
+    slip[i] = val;
+  }
+  return slip;
+}
+
+/// Decides the modes and sliding directions of every closed contact with
+/// friction whose slip is zero at (t_, q_, v_), together (above); `forced`
+/// (a row index, or −1) slides. false with `error` when a solve fails; a
+/// sweep that does not settle leaves the modes as they were (the friction
+/// phase then decides them one at a time).
+bool Simulator::frictionOnset(int forced, std::string& error) {
+  auto& u = *uni_;
+  const ContactEventOptions& o = options_.contacts;
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  u.onset.clear();
+  int F = 0;
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    UnilateralRow& r = u.rows[k];
+    if (r.nf == 0 || !cdata_->isActive(r.c)) continue;
+    if (k != forced && contactSlip(k).norm() > o.speed_tol) continue;
+    r.first_force = F;
+    F += r.nf;
+    u.onset.push_back(k);
+  }
+  const int K = static_cast<int>(u.onset.size());
+  if (K == 0) return true;
+  // Release their friction rows.
+  for (int j = 0; j < K; ++j) {
+    UnilateralRow& r = u.rows[u.onset[j]];
+    u.was_sliding[u.onset[j]] = cdata_->isSliding(r.c);
+    cdata_->setSliding(r.c, true);
+    r.released = true;
+  }
+  auto restore = [&] {
+    for (int j = 0; j < K; ++j) {
+      UnilateralRow& r = u.rows[u.onset[j]];
+      r.released = false;
+      cdata_->setSliding(r.c, u.was_sliding[u.onset[j]] != 0);
+    }
+  };
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  // Generalized force per unit force along each released row.
+  for (int j = 0; j < K; ++j) {
+    const UnilateralRow& r = u.rows[u.onset[j]];
+    const auto& sr = cdata_->slide[r.c];
+    for (int i = 0; i < r.nf; ++i) {
+      auto col = u.U.col(r.first_force + i);
+      col.setZero();
+      if (r.a >= 0) {
+        spatialJacobianWorld(model_, *data_, r.a, u.J);
+        col.noalias() += u.J.transpose() * sr.Wa.row(i).transpose();
+      }
+      if (r.b >= 0) {
+        spatialJacobianWorld(model_, *data_, r.b, u.J);
+        col.noalias() -= u.J.transpose() * sr.Wb.row(i).transpose();
+      }
+    }
+  }
+  // Slip accelerations and normal loads of the candidates at joint forces τ'.
+  auto respond = [&](const VecX& tau, Eigen::Ref<VecX> acc, Eigen::Ref<VecX> load) {
+    if (!solveDynamics(t_, q_, v_, tau, u.res)) return false;
+    forwardKinematics(model_, *data_, q_, v_, u.res.vdot);
+    for (int j = 0; j < K; ++j) {
+      const UnilateralRow& r = u.rows[u.onset[j]];
+      const auto& sr = cdata_->slide[r.c];
+      const Vec6 aa = r.a >= 0 ? spatialAccelerationWorld(*data_, r.a) : Vec6::Zero();
+      const Vec6 ab = r.b >= 0 ? spatialAccelerationWorld(*data_, r.b) : Vec6::Zero();
+      for (int i = 0; i < r.nf; ++i)
+        acc[r.first_force + i] = sr.kappa[i] + sr.Wa.row(i).dot(aa) - sr.Wb.row(i).dot(ab);
+      load[j] = u.res.lambda[r.global];
+    }
+    return true;
+  };
+  tau_.setZero();
+  if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
+  if (!respond(tau_, u.a0.head(F), u.ln0.head(K))) {
+    restore();
+    error = "friction modes: " + u.res.error;
+    return false;
+  }
+  // Unit forces at the scale of the loads (the map is affine: any scale is
+  // exact up to round-off relative to τ).
+  const double scale = std::max(1.0, u.ln0.head(K).cwiseAbs().maxCoeff());
+  for (int c = 0; c < F; ++c) {
+    u.tau_f = tau_ + scale * u.U.col(c);
+    if (!respond(u.tau_f, u.acc.head(F), u.f.head(K))) {
+      restore();
+      error = "friction modes: " + u.res.error;
+      return false;
+    }
+    u.W.col(c).head(F) = (u.acc.head(F) - u.a0.head(F)) / scale;
+    u.N.col(c).head(K) = (u.f.head(K) - u.ln0.head(K)) / scale;
+  }
+  // Block Gauss–Seidel, the loads updated as it goes.
+  u.f.head(F).setZero();
+  bool settled = false;
+  for (int sweep = 0; sweep < 10000 && !settled; ++sweep) {
+    u.f_old.head(F) = u.f.head(F);
+    double fmax = 0;
+    for (int j = 0; j < K; ++j) {
+      const UnilateralRow& r = u.rows[u.onset[j]];
+      const int o0 = r.first_force, n = r.nf;
+      const double load = u.ln0[j] + u.N.row(j).head(F).dot(u.f.head(F));
+      const double radius = r.mu * std::max(0.0, load);
+      Mat3 H = Mat3::Zero();
+      H.topLeftCorner(n, n) = u.W.block(o0, o0, n, n);
+      H = 0.5 * (H + H.transpose()).eval();
+      Vec3 c = Vec3::Zero();
+      c.head(n) = u.a0.segment(o0, n) + u.W.block(o0, 0, n, F) * u.f.head(F) -
+                  H.topLeftCorner(n, n) * u.f.segment(o0, n);
+      Vec3 fj = diskMinimizer(H, c, n, radius);
+      if (u.onset[j] == forced && fj.norm() < radius) {
+        // At its slip event: on the cone, along the sticking force found
+        // (or the one it had).
+        const Vec3 d = fj.norm() > 0 ? Vec3(fj / fj.norm()) : Vec3(-r.dir);
+        fj = radius * d;
+      }
+      u.f.segment(o0, n) = fj.head(n);
+      fmax = std::max(fmax, radius);
+    }
+    settled = sweep > 0 && (u.f.head(F) - u.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
+                               1e-14 * std::max(fmax, 1e-300);
+  }
+  restore();
+  if (!settled) {
+    ++counters_.friction_onset_unsettled;
+    return true;
+  }
+  // Modes: a contact on its cone whose slip accelerates slides along that
+  // acceleration, against its friction.
+  u.acc.head(F) = u.a0.head(F) + u.W.topLeftCorner(F, F) * u.f.head(F);
+  const double atol = 1e-9 * std::max(1.0, u.acc.head(F).lpNorm<Eigen::Infinity>());
+  for (int j = 0; j < K; ++j) {
+    const int k = u.onset[j];
+    UnilateralRow& r = u.rows[k];
+    const int n = r.nf;
+    Vec3 fj = Vec3::Zero(), aj = Vec3::Zero();
+    fj.head(n) = u.f.segment(r.first_force, n);
+    aj.head(n) = u.acc.segment(r.first_force, n);
+    const double load = u.ln0[j] + u.N.row(j).head(F).dot(u.f.head(F));
+    const bool on_cone = fj.norm() >= (1 - 1e-9) * r.mu * std::max(0.0, load);
+    const bool slides = k == forced || (on_cone && aj.norm() > atol);
+    const bool was = u.was_sliding[k] != 0;
+    if (slides) {
+      r.dir = fj.norm() > 0 ? Vec3(-fj / fj.norm()) : Vec3(aj / aj.norm());
+      r.dir_start = r.dir;
+    }
+    cdata_->setSliding(r.c, slides);
+    if (slides && !was) logEvent(ContactEventKind::Slip, k, 0, 0, 0);
+    if (!slides && was && k != forced) logEvent(ContactEventKind::Stick, k, 0, 0, 0);
+  }
+  return true;
+}
+
+}  // namespace appell
