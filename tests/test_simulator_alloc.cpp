@@ -7,6 +7,7 @@
 #include <appell/kkt.hpp>
 #include <appell/simulator.hpp>
 
+#include "scene.hpp"
 #include "test_solver_rows.hpp"
 
 #include <gtest/gtest.h>
@@ -238,6 +239,62 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
       EXPECT_GE(events, 8) << "solver " << which << ", " << toString(it);
       EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
       EXPECT_TRUE(sim.isClosed(0));
+    }
+  }
+}
+
+// Friction events allocate nothing: a ball launched sliding sticks (the
+// stick event, decided by the onset problem), then a push F = kt along x
+// makes it slip again (the slip event at its cone: the onset problem with
+// that contact forced) — every workspace sized when the simulator is built.
+TEST(SimulatorAllocation, FrictionEventsDoNotAllocate) {
+  ModelBuilder b;
+  const double r = 0.1, m = 0.5, I = 0.4 * m * r * r, g = 9.81, mu = 0.3, k = 20.0;
+  const int ball = b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+                             Inertia{m, Vec3::Zero(), Vec3::Constant(I).asDiagonal()});
+  const Model model = b.build();
+  ContactSpec spec;
+  spec.kind = ContactKind::Rolling;
+  spec.body = ball;
+  spec.shape = Sphere{r, Vec3::Zero()};
+  spec.support = Support{Plane{}, StaticMotion{}, "ground", -1};
+  spec.mu = mu;
+  const ConstraintList c{makeContact(spec)};
+  VecX q = neutralConfiguration(model);
+  q[2] = r;
+  VecX v = VecX::Zero(model.nv);
+  v[3] = 1.0;  // sliding without spin: it sticks at t = 2v₀/(7μg) ≈ 0.097 s
+  for (int which = 0; which < 3; ++which) {
+    for (IntegratorType it : {IntegratorType::RK4, IntegratorType::DormandPrince54}) {
+      std::unique_ptr<ConstrainedSolver> solver;
+      if (which == 0) solver = std::make_unique<KktSolver>(model, c);
+      if (which == 1) solver = std::make_unique<AppellSolver>(model, c);
+      if (which == 2) solver = makeSolver(Formulation::Tree, model, c);
+      Simulator sim(model, c, std::move(solver), it);
+      // The push starts at 0.2 s; it slips when (2/7)F reaches μmg.
+      sim.setJointForces([&](double t, const VecX& qq, const VecX&, VecX& tau) {
+        const double F = t > 0.2 ? k * (t - 0.2) : 0.0;
+        tau.tail<3>() = scenes::floatingRotation(qq, 0).transpose() * Vec3(F, 0, 0);
+      });
+      ASSERT_TRUE(sim.setState(0, q, v));
+      long allocations = 0, slips = 0, sticks = 0;
+      const double t_end = 0.2 + 3.5 * mu * m * g / k + 0.1;
+      while (sim.time() < t_end) {
+        StepStatus st;
+        {
+          Arm arm;
+          st = sim.step(2e-3);
+          allocations += g_allocations;
+        }
+        ASSERT_TRUE(st.ok) << st.message;
+        for (const auto& e : sim.events()) {
+          slips += e.kind == ContactEventKind::Slip;
+          sticks += e.kind == ContactEventKind::Stick;
+        }
+      }
+      EXPECT_EQ(sticks, 1) << "solver " << which << ", " << toString(it);
+      EXPECT_GE(slips, 1) << "solver " << which << ", " << toString(it);
+      EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
     }
   }
 }

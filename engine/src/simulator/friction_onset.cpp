@@ -215,8 +215,9 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
       H.topLeftCorner(n, n) = u.W.block(o0, o0, n, n);
       H = 0.5 * (H + H.transpose()).eval();
       Vec3 c = Vec3::Zero();
-      c.head(n) = u.a0.segment(o0, n) + u.W.block(o0, 0, n, F) * u.f.head(F) -
-                  H.topLeftCorner(n, n) * u.f.segment(o0, n);
+      c.head(n) = u.a0.segment(o0, n);  // (products one by one: no temporaries)
+      c.head(n).noalias() += u.W.block(o0, 0, n, F) * u.f.head(F);
+      c.head(n).noalias() -= H.topLeftCorner(n, n) * u.f.segment(o0, n);
       Vec3 fj = diskMinimizer(H, c, n, radius);
       if (u.onset[j] == forced && fj.norm() < radius) {
         // At its slip event: on the cone, along the sticking force found
@@ -237,7 +238,8 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
   }
   // Modes: a contact on its cone whose slip accelerates slides along that
   // acceleration, against its friction.
-  u.acc.head(F) = u.a0.head(F) + u.W.topLeftCorner(F, F) * u.f.head(F);
+  u.acc.head(F) = u.a0.head(F);
+  u.acc.head(F).noalias() += u.W.topLeftCorner(F, F) * u.f.head(F);
   const double atol = 1e-9 * std::max(1.0, u.acc.head(F).lpNorm<Eigen::Infinity>());
   for (int j = 0; j < K; ++j) {
     const int k = u.onset[j];
