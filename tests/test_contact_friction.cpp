@@ -96,6 +96,59 @@ TEST(ContactFriction, PushedBallSlipsWhenTheDemandReachesMu) {
   }
 }
 
+// Protects separate static and kinetic coefficients: the static μₛ is the
+// cone sticking stays in, the kinetic μₖ the force while sliding. A rolling
+// ball pushed at its centre by F = kt slips when (2/7)F reaches μₛmg, at
+// t* = 7μₛmg/(2k), then accelerates at (F − μₖmg)/m with the friction force
+// μₖmg; a ball launched sliding on the flat decelerates at μₖg and starts
+// rolling at t = 2v₀/(7μₖg) (it sticks: the rolling ball needs no friction).
+TEST(ContactFriction, StaticAndKineticCoefficients) {
+  const double mu_s = 0.4, mu_k = 0.25, k = 4.0, t_star = 7 * mu_s * kM * kG / (2 * k);
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers}) {
+    BuiltScene s = ballWithFriction(mu_s, Vec3::Zero(), Vec3::Zero(), Vec3(0, 0, -kG));
+    ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+    spec.mu_kinetic = mu_k;
+    s.constraints[0] = makeContact(spec);
+    Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+    sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
+      tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
+    });
+    ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+    const auto events = appell::test::advanceCollecting(sim, t_star + 0.2);
+    ASSERT_EQ(events.size(), 1u) << toString(f);
+    EXPECT_EQ(events[0].kind, ContactEventKind::Slip);
+    EXPECT_NEAR(events[0].t, t_star, 1e-10) << "slips at the static cone";
+    const double t = sim.time(), vs = 5.0 / 7 * k * t_star * t_star / (2 * kM);
+    const double v = vs + (k * (t * t - t_star * t_star) / 2 - mu_k * kM * kG * (t - t_star)) / kM;
+    EXPECT_NEAR(centreVelocity(sim).x(), v, 1e-8) << "slides against the kinetic force";
+    EXPECT_NEAR(sim.lambda().head<2>().norm(), mu_k * kM * kG, 1e-9);
+  }
+  const double v0 = 2.0, t_roll = 2 * v0 / (7 * mu_k * kG);
+  BuiltScene s = ballWithFriction(mu_s, Vec3(v0, 0, 0), Vec3::Zero(), Vec3(0, 0, -kG));
+  ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+  spec.mu_kinetic = mu_k;
+  s.constraints[0] = makeContact(spec);
+  Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
+                IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+  ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
+  const auto events = appell::test::advanceCollecting(sim, t_roll + 0.1);
+  ASSERT_EQ(events.size(), 1u);  // sliding from the start (setState), then it sticks
+  EXPECT_EQ(events[0].kind, ContactEventKind::Stick);
+  EXPECT_NEAR(events[0].t, t_roll, 1e-10) << "decelerates at μₖg";
+  EXPECT_NEAR(centreVelocity(sim).x(), 5 * v0 / 7, 1e-9);
+  // A kinetic coefficient above the static one is refused by name.
+  spec.mu_kinetic = 0.5;
+  const ConstraintList bad{makeContact(spec)};
+  try {
+    Simulator wrong(s.model, bad, makeSolver(Formulation::Tree, s.model, bad),
+                    IntegratorType::DormandPrince54);
+    ADD_FAILURE() << "μₖ > μₛ accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("kinetic friction"), std::string::npos) << e.what();
+  }
+}
+
 // Protects: the friction angle. On an incline of angle α a ball rolls
 // (sticks) when tan α ≤ (7/2)μ, with a = (5/7)g sin α; above it slides from
 // rest with a = g(sin α − μ cos α) and ω̇ = 5μg cos α/(2r).

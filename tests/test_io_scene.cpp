@@ -217,3 +217,39 @@ TEST(IoScene, CollisionShapesForCollisionDetection) {
   const Scene sl = loadScene(kData + "scenes/sleigh.urdf");
   EXPECT_TRUE(as<Box>(collisionShapes(sl.geometry[0])[0]).half_extents.isApprox(Vec3(0.4, 0.2, 0.025)));
 }
+
+// Protects the static and kinetic coefficients of the scene block: both
+// read into the contact (μ the static one), and every inconsistent
+// combination refused by line and reason.
+TEST(IoScene, StaticAndKineticFrictionCoefficients) {
+  auto scene = [](const std::string& friction) {
+    return R"(<robot name="s">
+  <link name="ball"><inertial><mass value="1"/><inertia ixx="0.004" ixy="0" ixz="0" iyy="0.004" iyz="0" izz="0.004"/></inertial><collision><geometry><sphere radius="0.1"/></geometry></collision></link>
+  <appell>
+    <support name="ground" type="plane"/>
+    <contact name="foot" link="ball" kind="rolling" support="ground" )" +
+           friction + R"(/>
+    <initial><joint name="root_joint" xyz="0 0 0.1"/></initial>
+  </appell>
+</robot>)";
+  };
+  const Scene s = loadSceneFromString(scene(R"(mu_static="0.6" mu_kinetic="0.4")"), kData, "two");
+  EXPECT_DOUBLE_EQ(s.contacts[0]->friction(), 0.6);
+  EXPECT_DOUBLE_EQ(s.contacts[0]->kineticFriction(), 0.4);
+  const Scene one = loadSceneFromString(scene(R"(mu="0.5")"), kData, "one");
+  EXPECT_DOUBLE_EQ(one.contacts[0]->kineticFriction(), 0.5) << "one coefficient for both";
+  for (const auto& [attrs, why] : std::vector<std::pair<std::string, std::string>>{
+           {R"(mu="0.5" mu_static="0.6" mu_kinetic="0.4")", "give either 'mu' or 'mu_static'"},
+           {R"(mu_kinetic="0.4")", "'mu_static' and 'mu_kinetic' go together"},
+           {R"(mu_static="0.3" mu_kinetic="0.4")", "'mu_kinetic' must not exceed 'mu_static'"},
+           {R"(mu_static="0.3" mu_kinetic="-1")", "must not be negative"}}) {
+    try {
+      loadSceneFromString(scene(attrs), kData, "bad");
+      ADD_FAILURE() << attrs << " accepted";
+    } catch (const SceneError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("bad:5: <contact name=\"foot\">", 0), 0u) << what;
+      EXPECT_NE(what.find(why), std::string::npos) << what;
+    }
+  }
+}

@@ -47,9 +47,15 @@ ContactKind contactKindFromString(const std::string& text) {
 
 ShapeContact::ShapeContact(ContactKind kind, int body, Shape shape, Support support,
                            const ContactOptions& options)
-    : ShapeContact(ContactSpec{kind, body, std::move(shape), std::move(support),
-                               std::numeric_limits<double>::infinity(), true, 0.0,
-                               options}) {}
+    : ShapeContact([&] {
+        ContactSpec spec;  // ideal rolling: infinite friction, unilateral, plastic
+        spec.kind = kind;
+        spec.body = body;
+        spec.shape = std::move(shape);
+        spec.support = std::move(support);
+        spec.options = options;
+        return spec;
+      }()) {}
 
 ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(rowCount(spec_.kind)) {
   const ContactKind kind = spec_.kind;

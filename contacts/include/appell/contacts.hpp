@@ -25,6 +25,7 @@
 
 #include <appell/name_table.hpp>
 
+#include <cmath>
 #include <limits>
 #include <memory>
 
@@ -62,6 +63,10 @@ struct ContactSpec {
   /// finite μ a unilateral contact sticks while |λₜ| ≤ μ λₙ and slides
   /// beyond (docs/contacts.md §8); 0: frictionless sliding.
   double mu = std::numeric_limits<double>::infinity();
+  /// Coulomb's kinetic coefficient, the force μₖλₙ of a sliding contact
+  /// (≤ mu, which is then the static one: the cone that sticking must stay
+  /// in). NaN: the same as mu.
+  double mu_kinetic = std::numeric_limits<double>::quiet_NaN();
   /// The contact can open: it lifts off when its normal force would pull and
   /// closes when its gap reaches zero (contact_events.hpp). false: a
   /// bilateral idealisation (a wheel on a rail that holds it down).
@@ -93,6 +98,9 @@ class ShapeContact : public Constraint {
   double restitution() const override { return spec_.restitution; }
   /// Coulomb's μ of the tangent/lateral rows (spec().mu; ∞: ideal rolling).
   double friction() const override { return spec_.mu; }
+  double kineticFriction() const override {
+    return std::isnan(spec_.mu_kinetic) ? spec_.mu : spec_.mu_kinetic;
+  }
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;

@@ -114,6 +114,10 @@ class Constraint {
   /// −μ λₙ ŝ against the slip direction (docs/contacts.md §8). ∞: never
   /// slides (ideal rolling). Only read when unilateral().
   virtual double friction() const { return std::numeric_limits<double>::infinity(); }
+  /// Coulomb's kinetic coefficient μₖ ≤ friction(): a sliding contact's
+  /// force is μₖ λₙ; friction() is then the static one, the cone sticking
+  /// stays in and a stopped slip must fit to stick again. Default: the same.
+  virtual double kineticFriction() const { return friction(); }
   /// Constant-size storage the block needs (called once, outside the step).
   virtual void reserve(const Model& model, RowBlock& block) const;
   /// Writes the rows at (q, v, t). `data` holds forwardKinematics(q, v).

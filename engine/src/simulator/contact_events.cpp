@@ -61,8 +61,14 @@ void Simulator::setUpUnilateral() {
     if (!(mu >= 0))
       throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has friction μ = " +
                                   std::to_string(mu) + " (must be ≥ 0)");
+    const double mu_k = con.kineticFriction();
+    if (!(mu_k >= 0 && mu_k <= mu))
+      throw std::invalid_argument("Simulator: constraint '" + con.name() +
+                                  "' has kinetic friction μₖ = " + std::to_string(mu_k) +
+                                  " outside [0, μ = " + std::to_string(mu) + "]");
     if (std::isfinite(mu) && cdata_->slide[c].n > 0) {
       r.mu = mu;
+      r.mu_k = mu_k;
       r.nf = cdata_->slide[c].n;
     }
     uni_->rows.push_back(r);

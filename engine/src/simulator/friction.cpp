@@ -63,7 +63,7 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
     UnilateralRow& r = u->rows[u->sliding[j]];
     slipDirection(*cdata_, r, 10 * options_.contacts.speed_tol);
     const auto& sr = cdata_->slide[r.c];
-    const Vec3 f = -r.mu * r.dir;  // components along the friction rows
+    const Vec3 f = -r.mu_k * r.dir;  // components along the friction rows (kinetic μ)
     auto g = u->G.col(j);
     g.setZero();
     if (r.a >= 0) {
@@ -112,7 +112,7 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
       const UnilateralRow& r = u->rows[u->sliding[j]];
       const auto& sr = cdata_->slide[r.c];
       for (int i = 0; i < sr.n; ++i)
-        out.lambda[cdata_->offset[r.c] + sr.row[i]] = -r.mu * u->s[j] * r.dir[i];
+        out.lambda[cdata_->offset[r.c] + sr.row[i]] = -r.mu_k * u->s[j] * r.dir[i];
     }
   }
   return true;

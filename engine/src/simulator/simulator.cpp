@@ -144,7 +144,7 @@ bool Simulator::evaluateEndState(std::string& error) {
     if (uni_)
       for (const auto& r : uni_->rows)
         if (cdata_->isActive(r.c) && cdata_->isSliding(r.c))
-          power += r.mu * std::max(0.0, result_.lambda[r.global]) * cdata_->slide[r.c].slip.norm();
+          power += r.mu_k * std::max(0.0, result_.lambda[r.global]) * cdata_->slide[r.c].slip.norm();
     // Work put in: by the joint forces, τ·v, and by the constraints, whose
     // force Aᵀλ has power vᵀAᵀλ = −λᵀb on A v + b = 0 — nonzero only for
     // rows that move in time (a turntable, a conveyor, a driven joint row).

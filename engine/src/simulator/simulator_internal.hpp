@@ -93,7 +93,8 @@ struct UnilateralRow {
   double gap_start = 0;   // gap at the start of the step (open contacts)
   // Coulomb friction (friction.cpp): μ, and while sliding the slip direction
   // in the friction rows' coordinates (unit; kept when the slip is ~0).
-  double mu = std::numeric_limits<double>::infinity();
+  double mu = std::numeric_limits<double>::infinity();  // static: the sticking cone
+  double mu_k = std::numeric_limits<double>::infinity();  // kinetic: the sliding force
   int nf = 0;             // friction rows (0: frictionless or bilateral)
   Vec3 dir = Vec3::Zero();
   Vec3 dir_start = Vec3::Zero();  // at the step's start: the slip-reversal event's reference

@@ -134,7 +134,8 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
   const bool has_shape = has(e, "shape"), has_point = has(e, "point");
   if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
   static const char* const kCommon[] = {"name",      "link",        "kind",      "support",
-                                        "mu",        "direction",   "restitution", "unilateral"};
+                                        "mu",        "direction",   "restitution", "unilateral",
+                                        "mu_static", "mu_kinetic"};
   auto allow = [&](const std::vector<const char*>& extra) {
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string n = a->Name();
@@ -204,6 +205,19 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
   if (has(e, "mu")) {
     d.spec.mu = number(src, e, "mu");
     if (d.spec.mu < 0) fail(src, e, "friction coefficient 'mu' must not be negative");
+  }
+  // Separate static and kinetic coefficients: both, instead of 'mu'.
+  if (has(e, "mu_static") || has(e, "mu_kinetic")) {
+    if (has(e, "mu")) fail(src, e, "give either 'mu' or 'mu_static' with 'mu_kinetic', not both");
+    if (!has(e, "mu_static") || !has(e, "mu_kinetic"))
+      fail(src, e, "'mu_static' and 'mu_kinetic' go together (one coefficient for both: 'mu')");
+    d.spec.mu = number(src, e, "mu_static");
+    d.spec.mu_kinetic = number(src, e, "mu_kinetic");
+    if (!(d.spec.mu_kinetic >= 0))
+      fail(src, e, "kinetic friction coefficient 'mu_kinetic' must not be negative");
+    if (!(d.spec.mu_kinetic <= d.spec.mu))
+      fail(src, e, "'mu_kinetic' must not exceed 'mu_static' (a contact that starts to slide "
+                   "would hold harder than sticking could)");
   }
   if (has(e, "restitution")) {
     d.spec.restitution = number(src, e, "restitution");
