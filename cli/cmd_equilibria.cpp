@@ -13,7 +13,7 @@ namespace appell::cli {
 
 namespace {
 
-const char* kHelp = R"(usage: appell equilibria SCENE.urdf [options]
+const char* kEquilibriaHelp = R"(usage: appell equilibria SCENE.urdf [options]
 
 Solves Q(q) + Aᵀ(q) λ = 0 with the holonomic gaps g(q) = 0 for (q, λ), keeping
 the multipliers as unknowns, so equilibria held only by nonholonomic reactions
@@ -38,7 +38,7 @@ int equilibria(int argc, char** argv) {
   Args args(argc, argv, 2, {"starts", "spread", "seed", "tol", "package-path"},
             {"help", "project-initial", "no-joint-limits"});
   if (args.has("help")) {
-    std::cout << kHelp;
+    std::cout << kEquilibriaHelp;
     return 0;
   }
   const Scene scene = loadFromArgs(args, false);

@@ -16,7 +16,7 @@ namespace appell::cli {
 
 namespace {
 
-const char* kHelp = R"(usage: appell info SCENE.urdf [--package-path DIRS] [--project-initial] [--no-joint-limits]
+const char* kInfoHelp = R"(usage: appell info SCENE.urdf [--package-path DIRS] [--project-initial] [--no-joint-limits]
 
 Prints the bodies (joint type, parent, mass), the degrees of freedom (nq, nv),
 the links merged on fixed joints, the meshes (triangles, vertices), every
@@ -31,7 +31,7 @@ the residuals of the initial state.
 int info(int argc, char** argv) {
   Args args(argc, argv, 2, kLoadOptions, kLoadFlags);
   if (args.has("help")) {
-    std::cout << kHelp;
+    std::cout << kInfoHelp;
     return 0;
   }
   const Scene scene = loadFromArgs(args, false);

@@ -21,7 +21,7 @@ namespace appell::cli {
 
 namespace {
 
-const char* kHelp = R"(usage: appell linearize SCENE.urdf [options]
+const char* kLinearizeHelp = R"(usage: appell linearize SCENE.urdf [options]
 
 Linearizes the constrained dynamics on the constraint manifold about the
 scene's initial state and prints the eigenvalues.
@@ -267,7 +267,7 @@ int linearize(int argc, char** argv) {
             {"cyclic", "formulation", "zero-tol", "package-path", "fd-step", "set", "sweep", "format", "plot"},
             {"help", "equilibrium", "project-initial", "no-joint-limits"});
   if (args.has("help")) {
-    std::cout << helpText(kHelp);
+    std::cout << helpText(kLinearizeHelp);
     return 0;
   }
   const std::string format = args.text("format", "text");

@@ -8,7 +8,7 @@ namespace appell::cli {
 
 namespace {
 
-const char* kHelp = R"(usage: appell plot RUN.csv [options]
+const char* kPlotHelp = R"(usage: appell plot RUN.csv [options]
 
 Plots a trajectory that `appell run --out RUN.csv` wrote, with gnuplot:
   energy.png      E(t) and E(t) − E(0)
@@ -27,7 +27,7 @@ The .dat files gnuplot reads and its .gp scripts are written beside them.
 int plot(int argc, char** argv) {
   Args args(argc, argv, 2, {"out", "scene", "package-path"}, {"help"});
   if (args.has("help")) {
-    std::cout << kHelp;
+    std::cout << kPlotHelp;
     return 0;
   }
   if (args.positional().size() != 1) throw UsageError("expected exactly one RUN.csv argument");

@@ -24,7 +24,7 @@ namespace appell::cli {
 
 namespace {
 
-const char* kHelp = R"(usage: appell run SCENE.urdf [options]
+const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
 
   --duration T        simulated time in seconds (default: the scene's)
   --dt H              fixed step (euler, rk4), first step (dopri5)
@@ -325,7 +325,7 @@ int run(int argc, char** argv) {
              "max-energy-error", "max-residual", "set", "sweep", "format"},
             {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
-    std::cout << helpText(kHelp);
+    std::cout << helpText(kRunHelp);
     return 0;
   }
   // Overrides change the state: check it after them, not at load.

@@ -26,7 +26,7 @@ namespace appell::cli {
 
 namespace {
 
-const char* kHelp = R"(usage: appell view SCENE.urdf [options]
+const char* kViewHelp = R"(usage: appell view SCENE.urdf [options]
 
 Writes one HTML file that replays the motion in 3-D (three.js, embedded: the
 page loads nothing). Open it in a browser: play/pause, scrub, orbit with the mouse.
@@ -332,7 +332,7 @@ int view(int argc, char** argv) {
   valued.insert({"trajectory", "out"});
   Args args(argc, argv, 2, valued, kLoadFlags);
   if (args.has("help")) {
-    std::cout << kHelp;
+    std::cout << kViewHelp;
     return 0;
   }
   if (viewer::script().empty())

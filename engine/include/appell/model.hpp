@@ -33,6 +33,9 @@ enum class JointType { Fixed, Revolute, Continuous, Prismatic, Planar, Floating,
 const char* toString(JointType type);
 int jointNq(JointType type);
 int jointNv(JointType type);
+/// Revolute, continuous and prismatic joints: one scalar coordinate (the joints
+/// a mimic, a servo or a joint-space coupling can act on).
+inline bool oneDofJoint(JointType type) { return jointNv(type) == 1; }
 
 /// Position limits kept from the model description (not enforced by the
 /// dynamics; reported and available to controllers and contact code).

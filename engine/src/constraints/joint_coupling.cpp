@@ -5,14 +5,6 @@
 
 namespace appell {
 
-namespace {
-
-bool oneDof(JointType t) {
-  return t == JointType::Revolute || t == JointType::Continuous || t == JointType::Prismatic;
-}
-
-}  // namespace
-
 JointCoupling::JointCoupling(const Model& model, int follower, int leader, double multiplier,
                              double offset)
     : follower_(follower), leader_(leader), multiplier_(multiplier), offset_(offset) {
@@ -27,7 +19,7 @@ JointCoupling::JointCoupling(const Model& model, int follower, int leader, doubl
   };
   if (follower == leader) fail("a joint cannot mimic itself");
   for (int j : {follower, leader})
-    if (!oneDof(model.joints[j].type))
+    if (!oneDofJoint(model.joints[j].type))
       fail(std::string("'") + model.joint_names[j] + "' is a " + toString(model.joints[j].type) +
            " joint; only revolute, continuous and prismatic joints can be coupled");
   if (!std::isfinite(multiplier) || !std::isfinite(offset)) fail("multiplier and offset must be finite");

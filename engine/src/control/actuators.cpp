@@ -29,9 +29,6 @@ int segment(const Schedule& s, double time) {
   return static_cast<int>(it - s.t.begin()) - 1;
 }
 
-bool oneDof(JointType t) {
-  return t == JointType::Revolute || t == JointType::Continuous || t == JointType::Prismatic;
-}
 
 }  // namespace
 
@@ -60,7 +57,7 @@ void Actuator::validate(const Model& model) const {
   };
   if (joint < 0 || joint >= model.nbodies) fail("no joint " + std::to_string(joint));
   const JointType jt = model.joints[joint].type;
-  if (!oneDof(jt))
+  if (!oneDofJoint(jt))
     fail(std::string("joint '") + model.joint_names[joint] + "' is " + toString(jt) +
          "; servos drive revolute, continuous and prismatic joints");
   if (!std::isfinite(kp) || kp < 0) fail("kp must be finite and ≥ 0");

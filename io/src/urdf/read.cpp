@@ -338,20 +338,17 @@ UrdfJoint readJoint(const XmlSource& src, const TiXmlElement* j) {
 // others is either redundant or contradicts itself). Chains are fine: each
 // link of the chain is its own constraint row.
 void checkMimics(const XmlSource& src, const UrdfRobot& ix) {
-  auto oneDof = [](JointType t) {
-    return t == JointType::Revolute || t == JointType::Continuous || t == JointType::Prismatic;
-  };
   for (const std::string& name : ix.joint_order) {
     const UrdfJoint& j = ix.joints.at(name);
     if (!j.mimic) continue;
     const UrdfMimic& m = *j.mimic;
-    if (!oneDof(j.type))
+    if (!oneDofJoint(j.type))
       fail(src, m.element, std::string("a ") + toString(j.type) +
                                " joint cannot mimic (only revolute, continuous and prismatic joints)");
     const auto leader = ix.joints.find(m.joint);
     if (leader == ix.joints.end()) fail(src, m.element, "mimics joint '" + m.joint + "', which is not declared");
     if (m.joint == name) fail(src, m.element, "joint '" + name + "' mimics itself");
-    if (!oneDof(leader->second.type))
+    if (!oneDofJoint(leader->second.type))
       fail(src, m.element, "mimics '" + m.joint + "', a " + toString(leader->second.type) +
                                " joint (only revolute, continuous and prismatic joints can be followed)");
     // Follow the chain of leaders; at most one step per joint.
