@@ -262,8 +262,8 @@ TEST(ContactVertices, CylinderStandingOnItsFaceLandsOnItsRim) {
 // friction: a block on an incline of angle α on four sticking corners (μ)
 // stays put when tan α < μ; when tan α > μ all four corners slide together
 // and the block accelerates down the slope at g (sin α − μ cos α), the
-// friction taking μ m g cos α per metre — Simulator::frictionWork() to the
-// trapezoidal rule's accuracy, and E + friction work conserved. The four
+// friction taking μ m g cos α per metre — Simulator::frictionWork(), and
+// E + friction work conserved to the integration tolerance. The four
 // normal rows are redundant (a block has 3 freedoms off the plane): the
 // sliding solve must still find the loads, and the onset of the slip must
 // give every corner its downhill direction at once.
@@ -318,9 +318,9 @@ TEST(ContactVertices, BlockOnAnInclineSticksOrSlidesByTheFrictionAngle) {
       EXPECT_NEAR(travelled, 0.5 * a * sim.time() * sim.time(), 1e-9)
           << "½ a t² from t = 0";
       EXPECT_LT(std::abs(sim.q()[1]), 1e-12) << "no sideways drift";
-      EXPECT_NEAR(sim.frictionWork(), mu * kMass * kG * std::cos(alpha) * travelled, 1e-6)
+      EXPECT_NEAR(sim.frictionWork(), mu * kMass * kG * std::cos(alpha) * travelled, 1e-9)
           << "friction takes μ m g cos α per metre";
-      EXPECT_LT(worst, 1e-6) << "E + friction work is conserved (trapezoidal rule)";
+      EXPECT_LT(worst, 1e-9) << "E + friction work is conserved";
     }
   }
 }

@@ -8,12 +8,17 @@
 //                    with rtol/atol and the usual PI-free step controller,
 //                    and Dormand & Prince's 4th-order continuous extension
 //                    as dense output (Hairer, Nørsett, Wanner I, §II.4–6) order 5
+// A field may also report scalar rates with each evaluation (the powers of the
+// work balance); every method integrates them over the accepted step with its
+// own weights — ∫ p dt as if ṗ-free components of the state, so the work
+// balance holds to the method's order, not to a trapezoidal rule's.
 // Work vectors are allocated at construction; step() does not allocate.
 #pragma once
 
 #include <appell/model.hpp>
 #include <appell/name_table.hpp>
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -24,8 +29,17 @@ namespace appell {
 /// not admissible" (non-finite, singular); the integrator then rejects the step.
 class AccelerationField {
  public:
+  /// At most this many rates (rateCount()).
+  static constexpr int kMaxRates = 3;
   virtual ~AccelerationField() = default;
   virtual bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) = 0;
+  /// Scalar rates evaluated by the last call of operator() (powers whose
+  /// integral over the step the caller wants: StepResult::integrals).
+  virtual int rateCount() const { return 0; }
+  virtual double rate(int i) const {
+    (void)i;
+    return 0;
+  }
 };
 
 enum class IntegratorType { SymplecticEuler, RK4, DormandPrince54 };
@@ -52,6 +66,9 @@ struct StepResult {
   double error = 0;          ///< scaled error norm of the accepted step (adaptive; 0 otherwise)
   int rejected = 0;          ///< rejected attempts before acceptance
   int evaluations = 0;       ///< calls to the field
+  /// ∫ rate(i) dt over the accepted step, by the method's own quadrature
+  /// (its stages and weights); zero past the field's rateCount().
+  std::array<double, AccelerationField::kMaxRates> integrals{};
 };
 
 class Integrator {

@@ -23,6 +23,7 @@
 #include <appell/integrators.hpp>
 #include <appell/projection.hpp>
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -128,19 +129,20 @@ class Simulator {
   /// E + impactEnergyLoss() is conserved by a passive scene.
   double impactEnergyLoss() const { return dissipated_; }
   /// Energy taken by sliding friction since setState() (J, ≥ 0): the power
-  /// μ λₙ |slip| of each sliding contact, integrated over each step by the
-  /// trapezoidal rule from the step's end states (an O(h²) quadrature, not
-  /// round-off: E + impactEnergyLoss() + frictionWork() is conserved by a
-  /// passive scene to that accuracy).
-  double frictionWork() const { return friction_work_; }
+  /// −vᵀQ_f of the friction forces Q_f the dynamics applied (μₖ λₙ |slip|
+  /// per contact sliding along its slip), integrated over each step by the
+  /// integrator's own stages and weights — to the method's order, like the
+  /// state itself: E + impactEnergyLoss() + frictionWork() is conserved by a
+  /// passive scene to the integration tolerance.
+  double frictionWork() const { return work_[kFrictionWork]; }
   /// Work done on the system since setState() (J), by the same quadrature:
   /// by the joint forces (∫ τ·v dt) and by constraints that move in time
   /// (∫ −λᵀb dt: a turntable or a conveyor drives through its rows). The
   /// balance E + impactEnergyLoss() + frictionWork() − jointWork() −
   /// supportWork() = E(0) holds for every scene (impacts on moving supports
   /// are counted in impactEnergyLoss()).
-  double jointWork() const { return joint_work_; }
-  double supportWork() const { return support_work_; }
+  double jointWork() const { return work_[kJointWork]; }
+  double supportWork() const { return work_[kSupportWork]; }
   /// Whether unilateral constraint `c` is closed now.
   bool isClosed(int constraint) const { return cdata_->isActive(constraint); }
   const SimulatorCounters& counters() const { return counters_; }
@@ -167,6 +169,8 @@ class Simulator {
   StepStatus locateAndHandleEvent(StepStatus st, double h);
   double eventFunction(int u, detail::Crossing type);
   bool restepTo(double tau, StepStatus& st);
+  /// work_ after an integrator step from the last step's start.
+  void takeStepWork(const StepResult& r);
   bool decideModes(std::string& error);
   bool featureSwitchImpact(std::string& error);
   bool projectAfterModes(std::string& error);
@@ -199,8 +203,10 @@ class Simulator {
   std::vector<ContactEvent> events_;
   std::string state_error_;
   double dissipated_ = 0;
-  double friction_work_ = 0, friction_power_ = 0, power_t_ = 0;
-  double joint_work_ = 0, joint_power_ = 0, support_work_ = 0, support_power_ = 0;
+  // Work integrals since setState(), now and at the last step's start (a
+  // step redone to an event starts from there): the Field's rates.
+  enum WorkIndex { kFrictionWork, kJointWork, kSupportWork };
+  std::array<double, 3> work_{}, work_prev_{};
 };
 
 }  // namespace appell

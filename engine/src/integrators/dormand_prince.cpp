@@ -61,6 +61,7 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
       r.ok = false;
       return r;
     }
+    readRates(f, rates_[0]);
   }
   for (;;) {
     bool field_ok = true;
@@ -76,6 +77,7 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
       localRate(model_, q, theta_, vs_, kth_[s]);
       ++r.evaluations;
       field_ok = f(t + C[s] * h, qs_, vs_, kv_[s]) && kv_[s].allFinite() && qs_.allFinite();
+      if (field_ok) readRates(f, rates_[s]);
     }
     double err = std::numeric_limits<double>::infinity();
     if (field_ok) {
@@ -104,7 +106,14 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
       t += h;
       // FSAL: the last stage is the next step's first. Swapped, not copied:
       // kv_[6] keeps this step's k₁ for the dense output (kv_[0] is its k₇).
+      // The rates by the same 5th-order weights (row 7 of A; b₇ = 0).
+      for (int i = 0; i < AccelerationField::kMaxRates; ++i) {
+        double sum = 0;
+        for (int k = 0; k < 6; ++k) sum += A[6][k] * rates_[k][i];
+        r.integrals[i] = h * sum;
+      }
       std::swap(kv_[0], kv_[6]);
+      std::swap(rates_[0], rates_[6]);
       have_fsal_ = true;
       r.h_taken = h;
       r.error = err;

@@ -8,6 +8,15 @@
 
 namespace appell::detail {
 
+/// The field's rates at one stage (AccelerationField::rate).
+using StageRates = std::array<double, AccelerationField::kMaxRates>;
+
+/// Reads the rates the field evaluated with its last call.
+inline void readRates(const AccelerationField& f, StageRates& out) {
+  const int n = f.rateCount();
+  for (int i = 0; i < AccelerationField::kMaxRates; ++i) out[i] = i < n ? f.rate(i) : 0.0;
+}
+
 class SymplecticEuler final : public Integrator {
  public:
   explicit SymplecticEuler(const Model& model);
@@ -28,6 +37,7 @@ class RungeKutta4 final : public Integrator {
  private:
   const Model& model_;
   std::array<VecX, 4> kth_, kv_;
+  std::array<StageRates, 4> rates_{};
   VecX theta_, vs_, qs_;
 };
 
@@ -44,6 +54,7 @@ class DormandPrince54 final : public Integrator {
   const Model& model_;
   IntegratorOptions opt_;
   std::array<VecX, 7> kth_, kv_;
+  std::array<StageRates, 7> rates_{};  // rates_[0] follows kv_'s FSAL swap
   VecX theta_, vs_, qs_, err_th_, err_v_, scale_q_;
   VecX q_start_, v_start_, dth_, dv_;  // the last accepted step, for dense output
   double h_last_ = 0;

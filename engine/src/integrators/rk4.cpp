@@ -31,6 +31,7 @@ StepResult RungeKutta4::step(AccelerationField& f, double& t, VecX& q, VecX& v, 
       r.ok = false;
       return r;
     }
+    readRates(f, rates_[s]);
   }
   theta_ = h * (w[0] * kth_[0] + w[1] * kth_[1] + w[2] * kth_[2] + w[3] * kth_[3]);
   vs_ = v + h * (w[0] * kv_[0] + w[1] * kv_[1] + w[2] * kv_[2] + w[3] * kv_[3]);
@@ -43,6 +44,9 @@ StepResult RungeKutta4::step(AccelerationField& f, double& t, VecX& q, VecX& v, 
   v = vs_;
   t += h;
   r.h_taken = r.h_next = h;
+  for (int i = 0; i < AccelerationField::kMaxRates; ++i)
+    r.integrals[i] = h * (w[0] * rates_[0][i] + w[1] * rates_[1][i] + w[2] * rates_[2][i] +
+                          w[3] * rates_[3][i]);
   return r;
 }
 

@@ -13,12 +13,15 @@ StepResult SymplecticEuler::step(AccelerationField& f, double& t, VecX& q, VecX&
   StepResult r;
   r.evaluations = 1;
   theta_.setZero();
-  if (!f(t, q, v, a_) || !a_.allFinite()) return {false, 0, h, 0, 0, 1};
+  if (!f(t, q, v, a_) || !a_.allFinite()) return {false, 0, h, 0, 0, 1, {}};
+  StageRates p;
+  readRates(f, p);
+  for (int i = 0; i < AccelerationField::kMaxRates; ++i) r.integrals[i] = h * p[i];  // order 1, as v
   v1_ = v + h * a_;
   localRate(model_, q, theta_, v1_, theta_);  // θ = 0 on entry: T(q, 0) v⁺
   theta_ *= h;
   retract(model_, q, theta_, q1_);
-  if (!v1_.allFinite() || !q1_.allFinite()) return {false, 0, h, 0, 0, 1};
+  if (!v1_.allFinite() || !q1_.allFinite()) return {false, 0, h, 0, 0, 1, {}};
   q = q1_;
   v = v1_;
   t += h;

@@ -155,10 +155,12 @@ bool Simulator::restepTo(double tau, StepStatus& st) {
   t_ = u.t0;
   q_ = u.q0;
   v_ = u.v0;
+  work_ = work_prev_;
   if (tau <= 0) return true;
   integrator_->reset();
   field_->clear();
   const StepResult r = integrator_->step(*field_, t_, q_, v_, tau);
+  takeStepWork(r);
   st.evaluations += r.evaluations;
   counters_.evaluations += r.evaluations;
   ++counters_.event_steps;

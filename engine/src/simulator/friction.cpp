@@ -52,6 +52,7 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
       if (cdata_->isActive(u->rows[k].c) && cdata_->isSliding(u->rows[k].c) && !u->rows[k].released)
         u->sliding.push_back(k);
   }
+  if (u) u->friction_power = 0;
   if (!u || u->sliding.empty()) {
     solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, outputs);
     return out.ok;
@@ -103,6 +104,8 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
   if (!u->s.head(k).allFinite()) return fail("the normal loads are not finite");
   u->tau_f = tau;
   for (int j = 0; j < k; ++j) u->tau_f.noalias() += u->s[j] * u->G.col(j);
+  // The power these forces take, −vᵀ(τ_f − τ): the work balance's rate.
+  for (int j = 0; j < k; ++j) u->friction_power -= u->s[j] * u->G.col(j).dot(v);
   solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u->tau_f, out, outputs);
   if (!out.ok) return false;
   if (outputs == SolveOutputs::All) {

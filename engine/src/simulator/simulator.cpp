@@ -64,10 +64,7 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   events_.clear();
   state_error_.clear();
   dissipated_ = 0;
-  friction_work_ = 0;
-  friction_power_ = 0;
-  joint_work_ = joint_power_ = support_work_ = support_power_ = 0;
-  power_t_ = t_;
+  work_ = work_prev_ = {};
   if (uni_ && options_.contacts.enabled) {
     // A new state: unilateral constraints with clearance start open, the
     // touching ones get their modes decided (impact, then forces).
@@ -101,6 +98,7 @@ void Simulator::restore() {
   t_ = t_prev_;
   q_ = q_prev_;
   v_ = v_prev_;
+  work_ = work_prev_;
   integrator_->reset();
   std::string ignored;
   evaluateEndState(ignored);
@@ -137,30 +135,6 @@ bool Simulator::evaluateEndState(std::string& error) {
   }
   kinetic_ = appell::kineticEnergy(model_, *data_, q_, v_);
   potential_ = appell::potentialEnergy(model_, *data_, q_);
-  // Work of sliding friction: its power μ λₙ |slip| per sliding contact,
-  // integrated over the step by the trapezoidal rule (O(h³) per step).
-  if (ok && options_.evaluate_end_state) {
-    double power = 0;
-    if (uni_)
-      for (const auto& r : uni_->rows)
-        if (cdata_->isActive(r.c) && cdata_->isSliding(r.c))
-          power += r.mu_k * std::max(0.0, result_.lambda[r.global]) * cdata_->slide[r.c].slip.norm();
-    // Work put in: by the joint forces, τ·v, and by the constraints, whose
-    // force Aᵀλ has power vᵀAᵀλ = −λᵀb on A v + b = 0 — nonzero only for
-    // rows that move in time (a turntable, a conveyor, a driven joint row).
-    const double joint_power = tau_.dot(v_);
-    const double support_power = -result_.lambda.dot(cdata_->b);
-    if (t_ > power_t_) {
-      const double h = t_ - power_t_;
-      friction_work_ += 0.5 * h * (friction_power_ + power);
-      joint_work_ += 0.5 * h * (joint_power_ + joint_power);
-      support_work_ += 0.5 * h * (support_power_ + support_power);
-    }
-    friction_power_ = power;
-    joint_power_ = joint_power;
-    support_power_ = support_power;
-    power_t_ = t_;
-  }
   return ok;
 }
 
@@ -180,6 +154,10 @@ StepStatus Simulator::projectState() {
   return st;
 }
 
+void Simulator::takeStepWork(const StepResult& r) {
+  for (int i = 0; i < static_cast<int>(work_.size()); ++i) work_[i] = work_prev_[i] + r.integrals[i];
+}
+
 StepStatus Simulator::step(double h) {
   StepStatus st;
   if (!(h > 0) || !std::isfinite(h)) {
@@ -190,9 +168,11 @@ StepStatus Simulator::step(double h) {
   t_prev_ = t_;
   q_prev_ = q_;
   v_prev_ = v_;
+  work_prev_ = work_;
   events_.clear();
   field_->clear();
   const StepResult r = integrator_->step(*field_, t_, q_, v_, h);
+  takeStepWork(r);
   st.h_taken = r.h_taken;
   st.h_next = r.h_next;
   st.rejected = r.rejected;

@@ -14,63 +14,6 @@
 
 namespace appell {
 
-// v̇ = f(t, q, v): joint forces, constraint rows, the solver. Failures are
-// remembered (with the reason) and reported as "not admissible" to the
-// integrator, which then rejects the step.
-class Simulator::Field final : public AccelerationField {
- public:
-  explicit Field(Simulator& s) : s_(s), tau_(VecX::Zero(s.model_.nv)) {}
-
-  bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) override {
-    Simulator& s = s_;
-    tau_.setZero();
-    if (s.tau_fn_) {
-      s.tau_fn_(t, q, v, tau_);
-      if (tau_.size() != s.model_.nv || !tau_.allFinite()) {
-        record("the joint-force callback returned a non-finite or wrongly sized tau", t);
-        return false;
-      }
-    }
-    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
-    if (s.options_.baumgarte.enabled)
-      applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
-                     s.options_.baumgarte.beta);
-    s.solveDynamics(t, q, v, tau_, stage_, SolveOutputs::Accelerations);
-    if (!stage_.ok) {
-      record(stage_.error, t);
-      return false;
-    }
-    if (!stage_.vdot.allFinite()) {
-      record("the solver returned a non-finite acceleration", t);
-      return false;
-    }
-    vdot = stage_.vdot;
-    return true;
-  }
-
-  void clear() {
-    failed_ = false;
-    message_.clear();
-  }
-  bool failed() const { return failed_; }
-  const std::string& message() const { return message_; }
-
- private:
-  void record(const std::string& why, double t) {
-    if (failed_) return;  // keep the first reason
-    failed_ = true;
-    std::ostringstream os;
-    os << why << " (at t = " << t << ")";
-    message_ = os.str();
-  }
-
-  Simulator& s_;
-  VecX tau_;
-  ConstrainedResult stage_;
-  bool failed_ = false;
-  std::string message_;
-};
-
 namespace detail {
 
 /// Per unilateral constraint: where its row is, and a copy of that row as
@@ -118,6 +61,7 @@ struct UnilateralState {
   std::vector<int> sliding;   // rows (indices into `rows`) sliding in this solve
   MatX G, J, R;               // nv × k friction forces per unit normal load; 6 × nv; k × k
   VecX lam0, s, tau_f;
+  double friction_power = 0;  // −vᵀ Σ sⱼ Gⱼ of the last solve: the power friction takes
   ConstrainedResult unit;
   Eigen::PartialPivLU<MatX> lu;
   // The onset problem (friction_onset.cpp), sized for every friction row:
@@ -131,5 +75,72 @@ struct UnilateralState {
 };
 
 }  // namespace detail
+
+// v̇ = f(t, q, v): joint forces, constraint rows, the solver. Failures are
+// remembered (with the reason) and reported as "not admissible" to the
+// integrator, which then rejects the step.
+class Simulator::Field final : public AccelerationField {
+ public:
+  explicit Field(Simulator& s) : s_(s), tau_(VecX::Zero(s.model_.nv)) {}
+
+  bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) override {
+    Simulator& s = s_;
+    tau_.setZero();
+    if (s.tau_fn_) {
+      s.tau_fn_(t, q, v, tau_);
+      if (tau_.size() != s.model_.nv || !tau_.allFinite()) {
+        record("the joint-force callback returned a non-finite or wrongly sized tau", t);
+        return false;
+      }
+    }
+    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
+    if (s.options_.baumgarte.enabled)
+      applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
+                     s.options_.baumgarte.beta);
+    // Rows that move in time (b ≠ 0) do work −λᵀb: only then are the
+    // multipliers needed at a stage.
+    const bool moving = (s.cdata_->b.array() != 0).any();
+    s.solveDynamics(t, q, v, tau_, stage_, moving ? SolveOutputs::All : SolveOutputs::Accelerations);
+    if (!stage_.ok) {
+      record(stage_.error, t);
+      return false;
+    }
+    if (!stage_.vdot.allFinite()) {
+      record("the solver returned a non-finite acceleration", t);
+      return false;
+    }
+    vdot = stage_.vdot;
+    // The powers of the work balance at this stage (Simulator::frictionWork).
+    rates_[kFrictionWork] = s.uni_ ? s.uni_->friction_power : 0.0;
+    rates_[kJointWork] = tau_.dot(v);
+    rates_[kSupportWork] = moving ? -stage_.lambda.dot(s.cdata_->b) : 0.0;
+    return true;
+  }
+  int rateCount() const override { return 3; }
+  double rate(int i) const override { return rates_[i]; }
+
+  void clear() {
+    failed_ = false;
+    message_.clear();
+  }
+  bool failed() const { return failed_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  void record(const std::string& why, double t) {
+    if (failed_) return;  // keep the first reason
+    failed_ = true;
+    std::ostringstream os;
+    os << why << " (at t = " << t << ")";
+    message_ = os.str();
+  }
+
+  Simulator& s_;
+  VecX tau_;
+  ConstrainedResult stage_;
+  std::array<double, 3> rates_{};
+  bool failed_ = false;
+  std::string message_;
+};
 
 }  // namespace appell

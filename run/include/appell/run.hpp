@@ -123,7 +123,7 @@ struct RunSummary {
   double energy0 = 0;              ///< E at t = 0 (J)
   double max_energy_deviation = 0; ///< max |E + impact losses + friction work − work in − E₀| (J)
   double impact_energy_loss = 0;   ///< kinetic energy taken by impacts (J)
-  double friction_work = 0;        ///< energy taken by sliding friction (J, trapezoidal rule)
+  double friction_work = 0;        ///< energy taken by sliding friction (J, Simulator::frictionWork)
   double joint_work = 0;           ///< work of the joint forces, ∫ τ·v dt (J)
   double support_work = 0;         ///< work of constraints that move in time, ∫ −λᵀb dt (J)
   std::vector<RunEvent> events;    ///< contact events, in time order
