@@ -141,7 +141,9 @@ int info(int argc, char** argv) {
               << " (" << closed - rank << " redundant), " << m.nv - rank
               << " independent velocities; residuals |Av+b| = " << sim->velocityResidual()
               << ", gap = " << sim->gapResidual() << "\n";
-    if (m.nv > 0 && m.nv - rank == 0)
+    if (m.nv > 0 && m.nv - rank == 0 && anyContactCanSlip(scene.constraints))
+      std::cout << "held still while its contacts stick: it moves only by slipping where μ is finite\n";
+    else if (m.nv > 0 && m.nv - rank == 0)
       std::cerr << "appell info: warning: " << scene.source
                 << ": the constraints leave 0 independent velocities — nothing in this scene can move "
                    "(axles out of line? rows that contradict each other?)\n";

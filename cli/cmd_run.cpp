@@ -190,7 +190,9 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
       << (o.project_velocities ? "" : "  [projection off]") << "\n"
       << "redundant    " << r.max_redundant << " rows\n"
       << "freedom      " << r.free_velocities << " independent velocities at t = 0";
-  if (r.free_velocities == 0 && scene.model.nv > 0)
+  if (r.free_velocities == 0 && scene.model.nv > 0 && r.can_slip)
+    out << " while its contacts stick: it moves only by slipping where μ is finite";
+  else if (r.free_velocities == 0 && scene.model.nv > 0)
     out << "  ⚠ the constraints hold every body still: nothing can move (an over-constrained "
            "vehicle — axles out of line by a CAD export's round-off make its no-slip rows "
            "independent; give its wheels a friction coefficient 'mu' so they can scrub, or "
@@ -398,7 +400,7 @@ int run(int argc, char** argv) {
   progress.done();
 
   printSummary(std::cout, scene, summary);
-  if (summary.free_velocities == 0 && scene.model.nv > 0)
+  if (summary.free_velocities == 0 && scene.model.nv > 0 && !summary.can_slip)
     std::cerr << "appell run: warning: " << scene.source
               << ": the constraints leave 0 independent velocities — nothing in this scene can move "
                  "(see 'freedom' in the summary)\n";

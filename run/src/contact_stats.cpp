@@ -95,7 +95,10 @@ void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
       e.max_demand = demand;
       e.t_max_demand = t;
     }
-    if (demand > e.mu && e.over_mu++ == 0) e.first_slip = t;
+    // Over μ is a finding only for a contact that is not sliding: a sliding
+    // one carries μₖλₙ exactly (up to round-off, hence the 1e-9).
+    const int c = cdata.row_constraint[e.normal_row];
+    if (!cdata.isSliding(c) && demand > e.mu * (1 + 1e-9) && e.over_mu++ == 0) e.first_slip = t;
   }
 }
 

@@ -80,6 +80,15 @@ void sampleActuators(RunSummary& s, const Scene& scene, const Simulator& sim) {
 
 }  // namespace
 
+bool anyContactCanSlip(const ConstraintList& constraints) {
+  for (const auto& c : constraints) {
+    if (!std::isfinite(c->friction())) continue;
+    for (int k = 0; k < c->rows(); ++k)
+      if (isTangential(c->rowKind(k))) return true;
+  }
+  return false;
+}
+
 int RunSummary::flaggedContacts() const {
   return static_cast<int>(
       std::count_if(contacts.begin(), contacts.end(), [](const ContactStats& c) { return c.flagged(); }));
@@ -131,6 +140,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.max_redundant = sim.redundantRows();
   s.free_velocities =
       scene.model.nv - (sim.constraintData().m_active - sim.redundantRows());
+  s.can_slip = anyContactCanSlip(scene.constraints);
   run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
   sampleActuators(s, scene, sim);
   s.samples = 1;

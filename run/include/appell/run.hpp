@@ -75,6 +75,10 @@ struct RunOptions {
 /// step or tolerance.
 RunOptions runOptions(const SimulationSettings& settings);
 
+/// Whether some constraint has friction rows (tangent, lateral) with a finite
+/// Coulomb coefficient — rows that can give way by sliding.
+bool anyContactCanSlip(const ConstraintList& constraints);
+
 /// One constraint's reactions over the run: a contact's normal load and friction
 /// demand (constraints with a normal row), a one-row coupling's reaction.
 struct ContactStats {
@@ -135,6 +139,10 @@ struct RunSummary {
   /// nv − rank(A) (0: nothing can move — an over-constrained vehicle whose
   /// axles are out of line, which the CLI warns about).
   int free_velocities = 0;
+  /// Some contact has friction rows with a finite μ: with free_velocities 0
+  /// the scene is held while its contacts stick, and moves only by slipping
+  /// (a braked car parked on a slope), not stuck for good.
+  bool can_slip = false;
   long samples = 0;                ///< states summarised (t = 0 and every step)
   std::vector<ContactStats> contacts;  ///< one per constraint, in order
   /// One per actuator (Scene::actuators), over the samples: the largest

@@ -1,0 +1,297 @@
+// Coulomb friction on vehicles and runners (docs/contacts.md §8): a
+// skid-steer robot that turns only because its tyres slip, a sleigh on ice
+// that slides sideways when its blade's lateral demand reaches μ, and a car
+// with locked wheels — parked on a 10° slope without creeping, sliding down
+// a slope steeper than its friction angle at g (sin θ − μₖ cos θ).
+#include <appell/run.hpp>
+#include <appell/simulator.hpp>
+#include <appell/urdf.hpp>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "simulation_helpers.hpp"
+#include "sleigh.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <regex>
+#include <sstream>
+#include <string>
+
+using namespace appell;
+using namespace appell::scenes;
+
+namespace {
+
+std::string example(const std::string& rel) { return std::string(APPELL_SOURCE_DIR) + "/examples/" + rel; }
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+double yaw(const VecX& q) {
+  const Mat3 R = Eigen::Quaterniond(q[6], q[3], q[4], q[5]).normalized().toRotationMatrix();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+
+/// |E + impact losses + friction work − work in − E₀|.
+double balanceError(const Simulator& sim, double E0) {
+  return std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - sim.jointWork() -
+                  sim.supportWork() - E0);
+}
+
+}  // namespace
+
+// Protects: friction lets a vehicle do what no-slip rows forbid. Four fixed
+// wheels (examples/skid_steer) allow no yaw while they roll without
+// slipping: with ideal tyres the robot drives dead straight whatever its
+// wheel servos do. With μ = 0.8 it drives straight while the servos agree
+// (the tyres stick), and turns left once the right wheels are driven faster:
+// the tyres slip (slip events), all four slide on the circle, and the work
+// balance E + friction work − motor work = E₀ closes to the integration
+// tolerance — friction takes most of what the motors put in.
+TEST(FrictionVehicles, SkidSteerTurnsOnlyBecauseItsTyresSlip) {
+  const std::string text = readText(example("skid_steer/skid_steer.urdf"));
+  const Scene scene = loadSceneFromString(text, example("skid_steer"), "skid_steer");
+  RunOptions o = runOptions(scene.settings);
+  o.tol = 1e-10;
+  auto sim = makeSimulator(scene, o);
+  const double E0 = sim->energy();
+  const auto before = appell::test::advanceCollecting(*sim, 1.5);
+  EXPECT_LT(std::abs(yaw(sim->q())), 1e-9) << "straight while the servos agree";
+  EXPECT_LT(std::abs(sim->q()[1]), 1e-9);
+  EXPECT_NEAR(sim->v()[3], 1.0, 1e-3) << "at the commanded 1 m/s";
+  for (int c = 0; c < 4; ++c) EXPECT_FALSE(sim->constraintData().isSliding(c)) << c;
+  const auto turning = appell::test::advanceCollecting(*sim, 4.0);
+  int slips = 0;
+  for (const ContactEvent& e : turning) slips += e.kind == ContactEventKind::Slip;
+  EXPECT_GT(slips, 0);
+  for (int c = 0; c < 4; ++c) EXPECT_TRUE(sim->constraintData().isSliding(c)) << c;
+  EXPECT_GT(sim->v()[2], 0.5) << "yaw rate: it turns left";
+  EXPECT_GT(sim->frictionWork(), 0.5 * sim->jointWork()) << sim->frictionWork() << " of " << sim->jointWork();
+  EXPECT_LT(balanceError(*sim, E0), 1e-9 * sim->jointWork());
+
+  // Ideal tyres: the same servos, no turn at all.
+  const std::string ideal = std::regex_replace(text, std::regex(R"( mu_static="[0-9.]+" mu_kinetic="[0-9.]+")"), "");
+  ASSERT_NE(ideal, text);
+  const Scene rigid = loadSceneFromString(ideal, example("skid_steer"), "skid_steer_ideal");
+  auto straight = makeSimulator(rigid, o);
+  const auto none = appell::test::advanceCollecting(*straight, 4.0);
+  EXPECT_TRUE(none.empty());
+  EXPECT_LT(std::abs(yaw(straight->q())), 1e-12);
+  EXPECT_LT(std::abs(straight->q()[1]), 1e-12);
+  EXPECT_GT(straight->q()[0], 3.0) << "it drove";
+}
+
+// Protects: the formulations agree with sliding contacts — the friction
+// forces enter the tree solver and the dense KKT system the same way (a
+// generalized force per unit normal load, normal loads from the k × k
+// system), so the skid-steer robot's turn, four tyres sliding in 2-D with
+// redundant rows, is the same motion in both (the sleigh test below checks
+// one sliding blade to 1e-10 in all three formulations).
+TEST(FrictionVehicles, TreeAndKktAgreeWhileTheTyresSlide) {
+  const Scene scene = loadScene(example("skid_steer/skid_steer.urdf"));
+  RunOptions o = runOptions(scene.settings);
+  o.tol = 1e-10;
+  auto tree = makeSimulator(scene, o);
+  o.formulation = Formulation::Multipliers;
+  auto kkt = makeSimulator(scene, o);
+  appell::test::advanceCollecting(*tree, 1.9);
+  appell::test::advanceCollecting(*kkt, 1.9);
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_TRUE(tree->constraintData().isSliding(c)) << c;
+    EXPECT_TRUE(kkt->constraintData().isSliding(c)) << c;
+  }
+  // Measured 3.4e-10 (q: wheel angles of ~10 rad), 2.0e-11 (v), 4.8e-10 (λ,
+  // loads of ~100 N) after 0.3 s of sliding, over 21 slip events.
+  EXPECT_LT((tree->q() - kkt->q()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((tree->v() - kkt->v()).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((tree->lambda() - kkt->lambda()).cwiseAbs().maxCoeff(), 2e-9);
+}
+
+// Protects: stick → slip on a knife edge. A Chaplygin sleigh on level ice,
+// started turning in place, speeds up along its blade while its turn slows:
+// the blade's lateral reaction grows from zero, peaks and decays. With μ at
+// half the peak demand the blade slips exactly where the ideal sleigh's
+// demand |λ_lat|/λₙ first reaches μ (the motions are the same until then);
+// sliding, the lateral force is μλₙ against the slip, and E + friction work
+// is conserved. Tree, KKT and Appell/Maggi agree while it slides.
+TEST(FrictionVehicles, SleighOnIceSlidesSidewaysWhenTheDemandReachesMu) {
+  SleighParams p = usualSleighParams(0.3, 0.0);
+  p.turn_rate = 3.0;
+  // The simulator keeps references to its model and constraints: they live
+  // with it, on the heap.
+  struct Run {
+    BuiltScene scene;
+    std::unique_ptr<Simulator> sim;
+  };
+  auto simulate = [&](double mu, Formulation f) {
+    auto r = std::make_unique<Run>();
+    r->scene = sleigh(p);
+    BuiltScene& s = r->scene;
+    if (std::isfinite(mu)) {
+      ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+      spec.mu = mu;
+      s.constraints[0] = makeContact(spec);
+    }
+    r->sim = std::make_unique<Simulator>(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                                         IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+    EXPECT_TRUE(r->sim->setState(0, s.q0, s.v0)) << r->sim->lastStateError();
+    return r;
+  };
+  // Rows: blade lateral, blade normal, the feet's normals.
+  auto demand = [](const Simulator& sim) { return std::abs(sim.lambda()[0]) / sim.lambda()[1]; };
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto ideal_run = simulate(inf, Formulation::Tree);
+  Simulator& ideal = *ideal_run->sim;
+  double peak = 0;
+  while (ideal.time() < 3.0 - 1e-12) {
+    ASSERT_TRUE(ideal.step(1e-2).ok);
+    peak = std::max(peak, demand(ideal));
+  }
+  ASSERT_GT(peak, 0.05);
+  const double mu = 0.5 * peak;
+
+  const auto icy_run = simulate(mu, Formulation::Tree);
+  Simulator& icy = *icy_run->sim;
+  const auto events = appell::test::advanceCollecting(icy, 3.0);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events[0].kind, ContactEventKind::Slip);
+  EXPECT_EQ(events[0].constraint, 0) << "the blade";
+  const double t_slip = events[0].t;
+  // The ideal sleigh at t_slip: its demand is μ there, below μ before.
+  const auto check_run = simulate(inf, Formulation::Tree);
+  Simulator& check = *check_run->sim;
+  while (check.time() < t_slip - 1e-12) {
+    const double h = std::min(1e-2, t_slip - check.time());
+    ASSERT_TRUE(check.step(h).ok);
+    if (check.time() < t_slip - 1e-9) {
+      EXPECT_LT(demand(check), mu) << "t = " << check.time();
+    }
+  }
+  EXPECT_NEAR(demand(check), mu, 1e-9) << "the slip is located where the demand reaches μ";
+
+  // Sliding: the force μλₙ against the blade's lateral slip (body y at the
+  // blade point, the body origin), energy gone only to friction.
+  EXPECT_TRUE(icy.constraintData().isSliding(0) || events.back().kind == ContactEventKind::Stick);
+  const auto slide_run = simulate(mu, Formulation::Tree);
+  Simulator& slide = *slide_run->sim;
+  const double E0 = slide.energy();
+  appell::test::advanceCollecting(slide, t_slip + 0.3);
+  ASSERT_TRUE(slide.constraintData().isSliding(0));
+  const double lateral_slip = slide.v()[4];
+  EXPECT_GT(std::abs(lateral_slip), 1e-4) << "it slides sideways";
+  EXPECT_NEAR(std::abs(slide.lambda()[0]), mu * slide.lambda()[1], 1e-9);
+  EXPECT_LT(slide.lambda()[0] * lateral_slip, 0) << "against the slip";
+  EXPECT_GT(slide.frictionWork(), 0);
+  EXPECT_LT(balanceError(slide, E0), 1e-10 * E0);
+  for (Formulation f : {Formulation::Multipliers, Formulation::Appell}) {
+    const auto other_run = simulate(mu, f);
+    Simulator& other = *other_run->sim;
+    appell::test::advanceCollecting(other, t_slip + 0.3);
+    EXPECT_LT((other.q() - slide.q()).cwiseAbs().maxCoeff(), 1e-10) << toString(f);
+    EXPECT_LT((other.v() - slide.v()).cwiseAbs().maxCoeff(), 1e-10) << toString(f);
+  }
+}
+
+namespace {
+
+/// examples/car with its wheels locked (fixed joints: the brakes), at rest,
+/// on a slope of θ (gravity tilted: downhill is +x), tyres μₛ = 0.9, μₖ = 0.7.
+Scene brakedCarOnASlope(double theta) {
+  std::string text = readText(example("car/car.urdf"));
+  text = std::regex_replace(text, std::regex(R"(type="continuous")"), R"(type="fixed")");
+  text = std::regex_replace(text, std::regex(R"(\s*<joint name="\w+_joint" position="0" velocity="[0-9.]+"/>)"), "");
+  text = std::regex_replace(text, std::regex(R"(velocity="0 0 0  1 0 0")"), R"(velocity="0 0 0  0 0 0")");
+  text = std::regex_replace(text, std::regex(R"( mu="0.9")"), R"( mu_static="0.9" mu_kinetic="0.7")");
+  std::ostringstream g;
+  g.precision(17);
+  g << R"(<gravity xyz=")" << 9.81 * std::sin(theta) << " 0 " << -9.81 * std::cos(theta) << R"("/>)";
+  text = std::regex_replace(text, std::regex(R"(<gravity xyz="0 0 -9.81"/>)"), g.str());
+  return loadSceneFromString(text, example("car"), "braked_car");
+}
+
+}  // namespace
+
+// Protects: sticking is exact, not a stiff spring. A car with its wheels
+// locked, parked 60 s on a 10° slope (tan θ = 0.18 < μₛ = 0.9), does not
+// move: its chassis stays within 1e-12 m of where it was put (engines with
+// soft or regularised contacts creep here). Its tyres hold m g sin θ
+// downhill and m g cos θ into the ground between them. The run summary says
+// it is held by sticking, not stuck for good.
+TEST(FrictionVehicles, BrakedCarParkedOnASlopeDoesNotCreep) {
+  const double theta = 10 * std::numbers::pi / 180, W = 24 * 9.81;
+  const Scene scene = brakedCarOnASlope(theta);
+  RunOptions o = runOptions(scene.settings);
+  auto sim = makeSimulator(scene, o);
+  const VecX q0 = sim->q();
+  const auto events = appell::test::advanceCollecting(*sim, 60.0, 0.5);
+  EXPECT_TRUE(events.empty());
+  EXPECT_LT((sim->q().head<3>() - q0.head<3>()).norm(), 1e-12) << "no creep";
+  EXPECT_LT(sim->v().norm(), 1e-12);
+  Vec3 force = Vec3::Zero();
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_FALSE(sim->constraintData().isSliding(c));
+    const ContactFrame& f = sim->contactFrame(c);
+    const VecX& l = sim->lambda();
+    force += l[3 * c] * f.t1 + l[3 * c + 1] * f.t2 + l[3 * c + 2] * f.normal;
+  }
+  EXPECT_NEAR(force.x(), -W * std::sin(theta), 1e-9) << "friction holds the weight's downhill part";
+  EXPECT_NEAR(force.z(), W * std::cos(theta), 1e-9);
+  const RunSummary r = runScene(scene, o);
+  EXPECT_EQ(r.free_velocities, 0);
+  EXPECT_TRUE(r.can_slip) << "held by sticking, not stuck for good";
+}
+
+// Protects: the same braked car on a slope steeper than its friction angle
+// (45°, tan θ = 1 > μₛ) slides from the first instant, all four tyres
+// together, at a = g (sin θ − μₖ cos θ), friction taking μₖ m g cos θ per metre.
+TEST(FrictionVehicles, BrakedCarSlidesDownASlopeSteeperThanItsFrictionAngle) {
+  const double theta = std::numbers::pi / 4, g = 9.81, m = 24;
+  const Scene scene = brakedCarOnASlope(theta);
+  RunOptions o = runOptions(scene.settings);
+  o.tol = 1e-12;
+  auto sim = makeSimulator(scene, o);
+  const VecX q0 = sim->q();
+  const double E0 = sim->energy();
+  appell::test::advanceCollecting(*sim, 1.0);
+  for (int c = 0; c < 4; ++c) EXPECT_TRUE(sim->constraintData().isSliding(c)) << c;
+  const double a = g * (std::sin(theta) - 0.7 * std::cos(theta)), t = sim->time();
+  const double travelled = sim->q()[0] - q0[0];
+  EXPECT_NEAR(travelled, 0.5 * a * t * t, 1e-9);
+  EXPECT_LT(std::abs(sim->q()[1] - q0[1]), 1e-12) << "straight down";
+  EXPECT_NEAR(sim->frictionWork(), 0.7 * m * g * std::cos(theta) * travelled, 1e-8);
+  EXPECT_LT(balanceError(*sim, E0), 1e-9);
+}
+
+// Protects the example as published (examples/block_incline): the block put
+// at rest on a slope steeper than μₛ slides from t = 0 at g (sin α − μₖ cos α)
+// on its four lower corners, straight downhill, E + friction work conserved.
+TEST(FrictionVehicles, BlockOnAnInclineExampleSlidesAtTheKineticRate) {
+  const double alpha = 0.5, g = 9.81, m = 3;
+  const Scene scene = loadScene(example("block_incline/block_incline.urdf"));
+  RunOptions o = runOptions(scene.settings);
+  auto sim = makeSimulator(scene, o);
+  const VecX q0 = sim->q();
+  const double E0 = sim->energy();
+  const std::vector<ContactEvent> start = sim->events();  // setState's own
+  ASSERT_EQ(start.size(), 4u) << "the four lower corners start sliding at once";
+  for (const ContactEvent& e : start) {
+    EXPECT_EQ(e.kind, ContactEventKind::Slip);
+    EXPECT_EQ(e.t, 0.0);
+  }
+  EXPECT_TRUE(appell::test::advanceCollecting(*sim, 1.0).empty()) << "then nothing changes";
+  const Vec3 down(-std::cos(alpha), 0, -std::sin(alpha));
+  const double travelled = (sim->q().head<3>() - q0.head<3>()).dot(down);
+  const double a = g * (std::sin(alpha) - 0.4 * std::cos(alpha));
+  EXPECT_NEAR(travelled, 0.5 * a * sim->time() * sim->time(), 1e-9);
+  EXPECT_LT(std::abs(sim->q()[1] - q0[1]), 1e-12) << "straight downhill";
+  EXPECT_NEAR(sim->frictionWork(), 0.4 * m * g * std::cos(alpha) * travelled, 1e-9);
+  EXPECT_LT(balanceError(*sim, E0), 1e-12 * m * g);
+}
