@@ -8,6 +8,8 @@
 #include "ball.hpp"
 #include "simulation_helpers.hpp"
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 
 using namespace appell;
@@ -169,5 +171,64 @@ TEST(ContactFriction, BallOnAnInclineRollsBelowTheFrictionAngleAndSlidesAbove) {
       const double wdot = slides ? 5 * mu * kG * std::cos(alpha) / (2 * kR) : a / kR;
       EXPECT_NEAR(angularVelocity(sim).y(), wdot * sim.time(), 1e-8) << "alpha " << alpha;
     }
+  }
+}
+
+// Protects: Painlevé's paradox is reported, not solved wrongly. A thin rod
+// (half-length l, I = m l²/3 about its centre) leaning at θ = atan 2 with its
+// lower end on the floor, the end sliding away from the rod's foot side.
+// Its friction μλₙ turns the rod down onto the floor, so the end's normal
+// acceleration answers its load with the coefficient
+// (1 + 3 cos θ (cos θ − μ sin θ))/m, negative for μ > 4/3 there (Stewart,
+// SIAM Review 42 (2000) 3–39): no consistent sliding mode. The simulator
+// names the contact and says so from μ = 1.34 up; at μ = 1.32 or 0.3, or
+// sliding the other way, the rod slides normally.
+TEST(ContactFriction, PainleveRodIsReportedWithTheContactNamed) {
+  const double l = 0.5, m = 1.0, theta = std::atan(2.0);
+  auto rod = [&](double mu, double slip) {
+    ModelBuilder b;
+    b.setGravity(Vec3(0, 0, -kG));
+    const int body = b.addBody("rod", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+                               principalInertia(m, Vec3(1e-4, m * l * l / 3, m * l * l / 3)), "free");
+    BuiltScene s;
+    s.model = b.build();
+    const Support floor{Plane{Vec3::Zero(), Vec3::UnitZ()}, StaticMotion{}, "floor"};
+    ContactOptions opt;
+    opt.name = "tip";
+    s.constraints.push_back(makeContact(ContactKind::Rolling, body, PointShape{Vec3(-l, 0, 0)}, floor, opt));
+    ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+    spec.mu = mu;
+    s.constraints[0] = makeContact(spec);
+    // Body x along the rod, from the tip A (on the floor) up to the centre G.
+    const Mat3 R = Eigen::AngleAxisd(-theta, Vec3::UnitY()).toRotationMatrix();
+    s.q0 = neutralConfiguration(s.model);
+    setFloatingPose(s.q0, 0, l * R.col(0), R);
+    s.v0 = floatingVelocity(R, Vec3::Zero(), Vec3(slip, 0, 0));
+    return s;
+  };
+  struct Case {
+    double mu, slip;
+    bool paradox;
+  };
+  // The threshold is 4/3 exactly: just below it the rod slides.
+  for (const Case c : {Case{2.0, -1.0, true}, Case{1.34, -1.0, true}, Case{1.32, -1.0, false},
+                       Case{2.0, 1.0, false}, Case{0.3, -1.0, false}}) {
+    SCOPED_TRACE("mu = " + std::to_string(c.mu) + ", slip " + std::to_string(c.slip));
+    BuiltScene s = rod(c.mu, c.slip);
+    Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+    const bool started = sim.setState(0, s.q0, s.v0);
+    if (c.paradox) {
+      EXPECT_FALSE(started);
+      EXPECT_NE(sim.lastStateError().find("'tip'"), std::string::npos) << sim.lastStateError();
+      EXPECT_NE(sim.lastStateError().find("Painlevé"), std::string::npos) << sim.lastStateError();
+      EXPECT_TRUE(sim.q().allFinite() && sim.v().allFinite());
+      continue;
+    }
+    ASSERT_TRUE(started) << sim.lastStateError();
+    EXPECT_TRUE(sim.constraintData().isSliding(0));
+    EXPECT_GT(sim.lambda()[2], 0) << "the floor pushes";
+    const StepStatus st = sim.step(1e-3);
+    EXPECT_TRUE(st.ok) << st.message;
   }
 }

@@ -98,8 +98,19 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
     return false;
   };
   // (1 − R) λₙ = λₙ⁰ on the leading k × k block (storage sized once).
+  // 1 − R is how the normal loads answer themselves through the friction
+  // they cause. A consistent, unique sliding mode for every λₙ⁰ needs it to
+  // be a P-matrix (Cottle, Pang & Stone, The Linear Complementarity Problem,
+  // 1992, §3.3): for one contact 1 − R > 0 — Painlevé's rod at μ > 4/3 is
+  // the classic failure (Stewart, SIAM Review 42 (2000) 3–39) — and a
+  // positive determinant in general (necessary). Otherwise the loads have no
+  // solution with λₙ ≥ 0 or several: reported, never picked.
   u->lu.compute(u->R.topLeftCorner(k, k));
-  if (!(std::abs(u->lu.determinant()) > 1e-12)) return fail("the normal loads are not determined");
+  const double det = u->lu.determinant();
+  if (!(std::abs(det) > 1e-12)) return fail("the normal loads are not determined");
+  if (det < 0)
+    return fail("the friction of the sliding contacts turns their normal loads against "
+                "themselves (det(1 − R) < 0)");
   u->s.head(k) = u->lu.solve(u->lam0.head(k));
   if (!u->s.head(k).allFinite()) return fail("the normal loads are not finite");
   u->tau_f = tau;
