@@ -697,8 +697,9 @@ bool Simulator::decideModes(std::string& error) {
 /// counted — instead of being absorbed unseen by the drift projection.
 bool Simulator::featureSwitchImpact(std::string& error) {
   auto& u = *uni_;
+  // The rows at the step's end; their forward kinematics (q, v) leave the
+  // bodies' velocities in data_ for the normal velocities below.
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  forwardKinematics(model_, *data_, q_, v_);
   bool approaching = false;
   for (const auto& r : u.rows) {
     if (r.joint || !cdata_->isActive(r.c)) continue;
