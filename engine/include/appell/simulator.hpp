@@ -205,8 +205,9 @@ class Simulator {
   double dissipated_ = 0;
   // Work integrals since setState(), now and at the last step's start (a
   // step redone to an event starts from there): the Field's rates.
-  enum WorkIndex { kFrictionWork, kJointWork, kSupportWork };
-  std::array<double, 3> work_{}, work_prev_{};
+  enum WorkIndex { kFrictionWork, kJointWork, kSupportWork, kWorkTerms };
+  static_assert(kWorkTerms <= AccelerationField::kMaxRates);
+  std::array<double, kWorkTerms> work_{}, work_prev_{};
 };
 
 }  // namespace appell

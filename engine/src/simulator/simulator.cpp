@@ -155,7 +155,7 @@ StepStatus Simulator::projectState() {
 }
 
 void Simulator::takeStepWork(const StepResult& r) {
-  for (int i = 0; i < static_cast<int>(work_.size()); ++i) work_[i] = work_prev_[i] + r.integrals[i];
+  for (int i = 0; i < kWorkTerms; ++i) work_[i] = work_prev_[i] + r.integrals[i];
 }
 
 StepStatus Simulator::step(double h) {

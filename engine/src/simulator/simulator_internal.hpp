@@ -116,7 +116,7 @@ class Simulator::Field final : public AccelerationField {
     rates_[kSupportWork] = moving ? -stage_.lambda.dot(s.cdata_->b) : 0.0;
     return true;
   }
-  int rateCount() const override { return 3; }
+  int rateCount() const override { return kWorkTerms; }
   double rate(int i) const override { return rates_[i]; }
 
   void clear() {
@@ -138,7 +138,7 @@ class Simulator::Field final : public AccelerationField {
   Simulator& s_;
   VecX tau_;
   ConstrainedResult stage_;
-  std::array<double, 3> rates_{};
+  std::array<double, kWorkTerms> rates_{};
   bool failed_ = false;
   std::string message_;
 };
