@@ -27,7 +27,7 @@ namespace {
 const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
 
   --duration T        simulated time in seconds (default: the scene's)
-  --dt H              fixed step (euler, rk4), first step (dopri5)
+  --dt H              fixed step (euler, leapfrog, rk4), first step (dopri5)
   --tol TOL           relative tolerance of the adaptive integrator (dopri5);
                       giving --tol without --integrator selects dopri5
   --integrator NAME   {integrators}

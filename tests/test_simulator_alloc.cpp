@@ -113,8 +113,8 @@ TEST(SimulatorAllocation, StepDoesNotAllocate) {
   v.segment<3>(3) = Vec3(0.5, -1.0, 2.0).cross(Vec3(0, 0, R));
   v[6] = 1.0;
   for (int which = 0; which < 3; ++which) {
-    for (IntegratorType it : {IntegratorType::SymplecticEuler, IntegratorType::RK4,
-                              IntegratorType::DormandPrince54}) {
+    for (IntegratorType it : {IntegratorType::SymplecticEuler, IntegratorType::Leapfrog,
+                              IntegratorType::RK4, IntegratorType::DormandPrince54}) {
       std::unique_ptr<ConstrainedSolver> solver;
       if (which == 0) solver = std::make_unique<KktSolver>(model, c);
       if (which == 1) solver = std::make_unique<AppellSolver>(model, c);
@@ -240,7 +240,8 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
   v.head<3>() = Vec3(0, 4.0, 1.0);  // spinning: the impacts are rolling impacts
   v[3] = 0.3;
   for (int which = 0; which < 3; ++which) {
-    for (IntegratorType it : {IntegratorType::RK4, IntegratorType::DormandPrince54}) {
+    for (IntegratorType it : {IntegratorType::Leapfrog, IntegratorType::RK4,
+                              IntegratorType::DormandPrince54}) {
       std::unique_ptr<ConstrainedSolver> solver = solverNumber(which, model, c);
       SimulatorOptions so;
       so.contacts.rest_speed = 0.01;
@@ -280,7 +281,8 @@ TEST(SimulatorAllocation, FrictionEventsDoNotAllocate) {
   VecX v = VecX::Zero(model.nv);
   v[3] = 1.0;  // sliding without spin: it sticks at t = 2v₀/(7μg) ≈ 0.097 s
   for (int which = 0; which < 3; ++which) {
-    for (IntegratorType it : {IntegratorType::RK4, IntegratorType::DormandPrince54}) {
+    for (IntegratorType it : {IntegratorType::Leapfrog, IntegratorType::RK4,
+                              IntegratorType::DormandPrince54}) {
       std::unique_ptr<ConstrainedSolver> solver = solverNumber(which, model, c);
       Simulator sim(model, c, std::move(solver), it);
       // The push starts at 0.2 s; it slips when (2/7)F reaches μmg.

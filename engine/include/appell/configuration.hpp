@@ -24,6 +24,14 @@ void retract(const Model& model, const VecX& q0, const VecX& theta, VecX& q);
 void localRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
                VecX& theta_dot);
 
+/// q = q0 ⊕ h v: where the configuration goes when the velocity v (body
+/// frame for rotations, as everywhere) is held constant for a time h — the
+/// exact flow of q̇ = G(q) v with v frozen (Pinocchio's `integrate`): the
+/// exponential of SO(3) and SE(3)/SE(2) twists, addition elsewhere. So
+/// integrate(q1, −v, h) undoes integrate(q0, v, h) exactly, which a symmetric
+/// method's drift needs (Hairer, Lubich & Wanner, GNI, §IV.8).
+void integrate(const Model& model, const VecX& q0, const VecX& v, double h, VecX& q);
+
 /// θ with retract(q0, θ) = q1 (the shortest rotation for quaternions).
 void difference(const Model& model, const VecX& q0, const VecX& q1, VecX& theta);
 

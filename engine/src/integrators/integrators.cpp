@@ -10,6 +10,8 @@ std::span<const NamedValue<IntegratorType>> integratorTable() {
   static const NamedValue<IntegratorType> table[] = {
       {IntegratorType::SymplecticEuler, "euler", {"symplectic_euler", "semi_implicit_euler"},
        "symplectic (semi-implicit) Euler, fixed step, order 1"},
+      {IntegratorType::Leapfrog, "leapfrog", {"verlet", "stormer_verlet", "rattle"},
+       "symmetric Störmer–Verlet (leapfrog) + projection (RATTLE-type), fixed step, order 2"},
       {IntegratorType::RK4, "rk4", {}, "classic Runge–Kutta–Munthe-Kaas, fixed step, order 4"},
       {IntegratorType::DormandPrince54, "dopri5", {"dormand_prince", "rk45"},
        "Dormand–Prince 5(4), adaptive step (tol), order 5"},
@@ -27,6 +29,7 @@ std::unique_ptr<Integrator> makeIntegrator(IntegratorType type, const Model& mod
                                            const IntegratorOptions& options) {
   switch (type) {
     case IntegratorType::SymplecticEuler: return std::make_unique<detail::SymplecticEuler>(model);
+    case IntegratorType::Leapfrog: return std::make_unique<detail::Leapfrog>(model, options);
     case IntegratorType::RK4: return std::make_unique<detail::RungeKutta4>(model);
     case IntegratorType::DormandPrince54:
       return std::make_unique<detail::DormandPrince54>(model, options);

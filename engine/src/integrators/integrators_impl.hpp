@@ -4,6 +4,8 @@
 #include <appell/configuration.hpp>
 #include <appell/integrators.hpp>
 
+#include <Eigen/Cholesky>
+
 #include <array>
 
 namespace appell::detail {
@@ -26,6 +28,28 @@ class SymplecticEuler final : public Integrator {
  private:
   const Model& model_;
   VecX a_, v1_, theta_, q1_;
+};
+
+class Leapfrog final : public Integrator {
+ public:
+  Leapfrog(const Model& model, const IntegratorOptions& options);
+  IntegratorType type() const override { return IntegratorType::Leapfrog; }
+  StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) override;
+
+ private:
+  void dropOldestPair();
+  const Model& model_;
+  IntegratorOptions opt_;
+  static constexpr int kAndersonDepth = 4;
+  using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kAndersonDepth, kAndersonDepth>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kAndersonDepth, 1>;
+  VecX a_, a_end_, a_shift_, vh_, g_, res_, g_prev_, res_prev_;
+  MatX dF_, dG_;  // Anderson's residual and image differences, nv × depth
+  int depth_ = 0;  // columns of dF_, dG_ in use (the newest last); kept across steps
+  static constexpr double kPairFloor = 1e-11;  // residuals below this (× scale) are round-off
+  static constexpr double kRoundOffFloor = 1e-11;
+  VecX q1_;
+  bool have_end_ = false;  // a_end_ = f(q⁺, v½) of the last step: the next predictor
 };
 
 class RungeKutta4 final : public Integrator {

@@ -45,6 +45,55 @@ void retract(const Model& model, const VecX& q0, const VecX& theta, VecX& q) {
   }
 }
 
+namespace {
+
+/// ∫₀¹ exp(s φ̂) ds, the left Jacobian of SO(3): p(h) − p(0) = R₀ J(hω) h v
+/// for a body twist (ω, v) held for a time h.
+Mat3 so3LeftJacobian(const Vec3& phi) {
+  const double a = phi.norm();
+  const Mat3 K = skew(phi);
+  // (1 − cos a)/a² and (a − sin a)/a³, by series where the quotients cancel
+  // (1 − cos a is taken as 2 sin²(a/2), which does not).
+  const double s = std::sin(a / 2);
+  const double c1 = a < 1e-4 ? 0.5 - a * a / 24 : 2 * s * s / (a * a);
+  const double c2 = a < 1e-4 ? 1.0 / 6 - a * a / 120 : (a - std::sin(a)) / (a * a * a);
+  return Mat3::Identity() + c1 * K + c2 * K * K;
+}
+
+}  // namespace
+
+void integrate(const Model& model, const VecX& q0, const VecX& v, double h, VecX& q) {
+  q = q0;
+  for (const Joint& j : model.joints) {
+    const int iq = j.idx_q, iv = j.idx_v;
+    switch (j.type) {
+      case JointType::Fixed: break;
+      case JointType::Floating: {
+        const Vec3 phi = h * v.segment<3>(iv);
+        const Quat r0 = quatAt(q0, iq + 3);
+        q.segment<3>(iq) += r0 * (so3LeftJacobian(phi) * (h * v.segment<3>(iv + 3)));
+        setQuat(q, iq + 3, r0 * quatExp(phi));
+        break;
+      }
+      case JointType::Ball: setQuat(q, iq, quatAt(q0, iq) * quatExp(h * v.segment<3>(iv))); break;
+      case JointType::Planar: {
+        // SE(2): (a, b) moves by Rot(φ₀) ∫₀ʰ Rot(s ω) ds (v_a, v_b).
+        const double w = h * v[iv + 2];
+        const double sw = std::abs(w) < 1e-4 ? 1 - w * w / 6 : std::sin(w) / w;
+        const double cw = std::abs(w) < 1e-4 ? w / 2 - w * w * w / 24
+                                             : 2 * std::sin(w / 2) * std::sin(w / 2) / w;  // (1 − cos w)/w
+        const double da = h * (sw * v[iv] - cw * v[iv + 1]), db = h * (cw * v[iv] + sw * v[iv + 1]);
+        const double c = std::cos(q0[iq + 2]), s = std::sin(q0[iq + 2]);
+        q[iq] += c * da - s * db;
+        q[iq + 1] += s * da + c * db;
+        q[iq + 2] += w;
+        break;
+      }
+      default: q.segment(iq, j.nq) += h * v.segment(iv, j.nv);
+    }
+  }
+}
+
 void localRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
                VecX& theta_dot) {
   for (const Joint& j : model.joints) {

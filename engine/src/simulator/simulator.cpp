@@ -181,6 +181,7 @@ StepStatus Simulator::step(double h) {
   counters_.evaluations += r.evaluations;
   if (!r.ok) {
     if (field_->failed()) return fail(st, field_->message());
+    if (r.failure) return fail(st, r.failure);
     return fail(st, integrator_->adaptive()
                         ? "the step size fell below h_min (the dynamics are too stiff or singular here)"
                         : "the integrator produced a non-finite state");
