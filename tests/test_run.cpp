@@ -171,7 +171,7 @@ TEST(Run, AFailingRunReportsItsTimeAndReason) {
 
 TEST(Run, BadOptionsAreRejected) {
   SimulationSettings s;
-  s.integrator = "leapfrog";
+  s.integrator = "adams_bashforth";
   EXPECT_THROW(runOptions(s), std::invalid_argument);
   s = SimulationSettings{};
   s.formulation = "quantum";

@@ -113,6 +113,10 @@ void velocityResiduals(const Data& data, const ConstraintList& constraints,
 /// The same at any v: recomputes forwardKinematics(q, v) into `data` first.
 double velocityResidual(const Model& model, Data& data, const ConstraintList& constraints,
                         const ConstraintData& cdata, const VecX& q, const VecX& v);
+/// Adds `delta` (size m) to the evaluated rows' velocity offsets b — in
+/// cdata.b and in each closed constraint's block — so that a solve or a
+/// projection over these rows sees A v + b + delta.
+void shiftRowOffsets(const ConstraintList& constraints, ConstraintData& cdata, const VecX& delta);
 /// max |gap| of the last evaluation.
 double gapResidual(const ConstraintData& cdata);
 

@@ -4,18 +4,15 @@
 // move by exact rotations:
 //   SymplecticEuler  v⁺ = v + h f(q, v),  q⁺ = retract(q, h v⁺)     order 1
 //   Leapfrog         generalised Störmer–Verlet, symmetric          order 2
-//                      v½ = v + ½h f(q, v½)      (implicit: fixed point)
+//                      v½ = v + ½h f(q, v½) + Δ   (implicit: fixed point)
 //                      q⁺ = q ⊕ h v½             (configuration.hpp, integrate)
 //                      v⁺ = v½ + ½h f(q⁺, v½)
-//                    With the simulator's projections after each step
-//                    (onto g = 0, then M-orthogonally onto A v + b = 0) it
-//                    is a RATTLE-type scheme: the constraints hold at every
-//                    step. Without them the map is exactly time-reversible
-//                    for any f with f(q, −v) = f(q, v) (every scleronomic
-//                    system: λ is quadratic in v), which is what keeps
-//                    energy errors bounded on reversible integrable problems
-//                    (Hairer, Lubich & Wanner, GNI, §XI; Modin & Verdier,
-//                    Numer. Math. 145 (2020) 405–435) — and only there.
+//                    With constraints it is a RATTLE-type scheme: Δ is an
+//                    impulse along the rows at q that makes the gaps vanish
+//                    at q⁺ and the other rows hold at the midpoint, and the
+//                    simulator's projection ends the step on A v + b = 0.
+//                    Time-reversible, so energy errors stay bounded on
+//                    reversible problems (leapfrog.cpp).
 //   RK4              classic 4-stage Runge–Kutta–Munthe-Kaas       order 4
 //   DormandPrince54  embedded 5(4) pair, FSAL, error control on (θ, v)
 //                    with rtol/atol and the usual PI-free step controller,
@@ -52,6 +49,29 @@ class AccelerationField {
   virtual double rate(int i) const {
     (void)i;
     return 0;
+  }
+  /// Whether constrainKick() does anything (the field has constraint rows).
+  virtual bool constrained() const { return false; }
+  /// v ← its M-orthogonal projection onto A(q) v + b(t) = 0 (constrained
+  /// fields; the leapfrog evaluates f only at velocities on the constraints,
+  /// where redundant rows are consistent). Returns false (remembering why)
+  /// when the rows are inconsistent. An unconstrained field leaves v alone.
+  virtual bool projectVelocity(double t, const VecX& q, VecX& v) {
+    (void)t, (void)q, (void)v;
+    return true;
+  }
+  /// One step toward the leapfrog's discrete constraints on a half-step
+  /// velocity w (leapfrog.cpp), by impulses along the rows at (t, q),
+  /// w ← w − M(q)⁻¹A(q)ᵀν:
+  ///   holonomic rows      g(q ⊕ h w, t + h) = 0              (RATTLE's)
+  ///   the other rows      A(q ⊕ ½h w) w + b(t + ½h) = 0     (at the midpoint)
+  /// — the M-orthogonal projection at q of those residuals. The rows move
+  /// with w by O(h), so one step contracts the residual by O(h) and the
+  /// caller iterates. Returns false (remembering why) when the rows are
+  /// inconsistent. An unconstrained field leaves w alone.
+  virtual bool constrainKick(double t, const VecX& q, double h, VecX& w) {
+    (void)t, (void)q, (void)h, (void)w;
+    return true;
   }
 };
 

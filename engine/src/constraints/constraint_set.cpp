@@ -233,6 +233,20 @@ double velocityResidual(const Model& model, Data& data, const ConstraintList& co
   return velocityResidual(data, constraints, cd, v);
 }
 
+void shiftRowOffsets(const ConstraintList& constraints, ConstraintData& cd, const VecX& delta) {
+  for (size_t k = 0; k < constraints.size(); ++k) {
+    if (!cd.isActive(static_cast<int>(k))) continue;  // zero rows stay zero
+    const Constraint& c = *constraints[k];
+    RowBlock& blk = cd.blocks[k];
+    const int o = cd.offset[k], m = c.rows();
+    for (int r = 0; r < m; ++r) {
+      if (c.jointSpace()) blk.b_joint[r] += delta[o + r];
+      else blk.b[r] += delta[o + r];
+      cd.b[o + r] += delta[o + r];
+    }
+  }
+}
+
 double gapResidual(const ConstraintData& cd) {
   double r = 0;  // closed constraints only: an open contact's gap is its clearance
   for (int i = 0; i < cd.m; ++i)

@@ -43,12 +43,13 @@ class Leapfrog final : public Integrator {
   static constexpr int kAndersonDepth = 4;
   using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kAndersonDepth, kAndersonDepth>;
   using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kAndersonDepth, 1>;
-  VecX a_, a_end_, a_shift_, vh_, g_, res_, g_prev_, res_prev_;
-  MatX dF_, dG_;  // Anderson's residual and image differences, nv × depth
+  VecX a_, a_end_, a_shift_, vh_, w_, y_, xp_;
+  VecX z_, g_, res_, g_prev_, res_prev_;  // the fixed point's (x, Δ), 2 nv
+  MatX dF_, dG_;  // Anderson's residual and image differences, 2 nv × depth
+  VecX q1_;       // q⁺
   int depth_ = 0;  // columns of dF_, dG_ in use (the newest last); kept across steps
   static constexpr double kPairFloor = 1e-11;  // residuals below this (× scale) are round-off
   static constexpr double kRoundOffFloor = 1e-11;
-  VecX q1_;
   bool have_end_ = false;  // a_end_ = f(q⁺, v½) of the last step: the next predictor
 };
 

@@ -1,39 +1,53 @@
-// Generalised Störmer–Verlet (leapfrog) for v̇ = f(t, q, v), q̇ = G(q) v:
-//   v½ = v + ½h f(t, q, v½)          implicit in v½: fixed-point iteration
-//   q⁺ = q ⊕ h v½                     exact flow of the frozen velocity
-//   v⁺ = v½ + ½h f(t + h, q⁺, v½)     explicit
-// (Hairer, Lubich & Wanner, Geometric Numerical Integration, §VI.3, the
-// non-separable Störmer–Verlet). The map is symmetric: stepping back from
-// (q⁺, −v⁺) with the same h returns (q, −v) exactly whenever f(q, −v) =
-// f(q, v), because q⁺ ⊕ (−h v½) = q (configuration.hpp, integrate) and the
-// two half-kicks are each other's adjoint. Symmetric and consistent, so of
-// order 2.
+// Generalised Störmer–Verlet (leapfrog) for v̇ = f(t, q, v), q̇ = G(q) v,
+// and with constraints the RATTLE-type scheme built on it:
+//   v½ = v + ½h F(t, q, v½) + Δ       Δ = M(q)⁻¹A(q)ᵀν, with the discrete
+//                                      constraints  g(q⁺) = 0  (holonomic
+//                                      rows, RATTLE's) and  A(q ⊕ ½h v½) v½
+//                                      + b = 0  (the others, at the midpoint)
+//   q⁺ = q ⊕ h v½                      exact flow of the frozen velocity
+//   v⁺ = v½ + ½h F(t + h, q⁺, v½)      then the simulator's M-orthogonal
+//                                      projection onto A(q⁺) v⁺ + b = 0
+// (unconstrained: Δ = 0, F = f, the non-separable Störmer–Verlet of Hairer,
+// Lubich & Wanner, Geometric Numerical Integration, §VI.3; RATTLE: Andersen,
+// J. Comput. Phys. 52 (1983) 24–34; the midpoint discrete constraint for
+// nonholonomic rows as in McLachlan & Perlmutter, J. Nonlinear Sci. 16
+// (2006) 283–328). The map is symmetric: from (q⁺, −v⁺) the same step returns
+// (q, −v), because q⁺ ⊕ (−h v½) = q (configuration.hpp, integrate), the
+// midpoint and the end gaps are the same seen from either end, and the end
+// projection is the first kick's impulse Δ run backwards — whenever
+// F(q, −v) = F(q, v) and b = 0 (every scleronomic system: the multipliers are
+// quadratic in v). Symmetric and consistent, so of order 2; the constraints
+// hold at every step; and on reversible integrable problems the energy error
+// stays bounded instead of drifting (Modin & Verdier, Numer. Math. 145
+// (2020) 405–435, who also show that this is lost on problems without the
+// reversibility). Projecting only at the end of the step (Δ = 0, the
+// simulator's projections alone) is not symmetric: on the rolling disk the
+// energy then drifts linearly (2·10⁻² in 200 s at h = 10 ms; bounded at
+// 2·10⁻⁴ with Δ).
 //
-// For a constrained system f is the constrained acceleration (any of the
-// three formulations); the simulator then projects q⁺ onto g = 0 and v⁺
-// M-orthogonally onto A v + b = 0 (projection.hpp). The last half-kick
-// followed by that projection is exactly RATTLE's: v⁺ = v½ + ½h M⁻¹(Q + Aᵀμ)
-// with A(q⁺) v⁺ + b = 0, whatever multiplier f used (Andersen 1983, "Rattle";
-// Leimkuhler & Reich, Simulating Hamiltonian Dynamics, §7.2). What keeps
-// energy errors bounded is the reversibility (Modin & Verdier 2020); the
-// projection, a non-symmetric map, is a perturbation of the size of the
-// drift it removes (O(h³) per step).
+// The first kick is a fixed point in (v½, Δ): each iteration evaluates F and
+// one constrainKick (the discrete constraints' residuals removed by impulses
+// at q; it contracts them by O(h)). It converges when ½h ‖∂F/∂v‖ < 1 —
+// gyroscopic and constraint-curvature terms, the size of the angular rates —
+// and is iterated to round-off, because a half-converged kick breaks the
+// symmetry. Plain iteration gains the factor ½h ‖∂F/∂v‖ per evaluation
+// (≈ 1/40 on the rolling disk at h = 10 ms: seven iterations); Anderson
+// mixing of the last few residuals (Walker & Ni, SIAM J. Numer. Anal. 49
+// (2011) 1715–1735; on a nearly linear map, GMRES on I − ½h ∂F/∂v) needs
+// three to five. Unconstrained, its history is kept from step to step
+// (∂f/∂v moves by O(h)); constrained it restarts each step, because Δ must
+// stay a combination of impulses at this step's q. The predictor
+// extrapolates the last step's stages: with A = F(q, v½) and B = F(q⁺, v½)
+// of the last step and B' the end stage before it, the next F(q⁺, v⁺½) ≈
+// B + (A − B') — A − B' is the change with the last velocity increment at
+// nearly the same configuration, which the next one repeats to O(h²).
 //
-// The fixed point converges when ½h ‖∂f/∂v‖ < 1 — gyroscopic and constraint-
-// curvature terms, of the size of the angular rates — and is iterated to
-// round-off, because a half-converged first kick breaks the symmetry. Plain
-// iteration gains the factor ½h ‖∂f/∂v‖ (≈ 1/40 on the rolling disk at
-// h = 10 ms: seven iterations); Anderson mixing of the last few residuals
-// (Walker & Ni, SIAM J. Numer. Anal. 49 (2011) 1715–1735) — on a nearly
-// linear map, GMRES on I − ½h ∂f/∂v — with its history kept from step to
-// step (∂f/∂v moves by O(h)) needs three to four: 5.4 evaluations per step
-// on the disk, 4.1 on the sleigh, against RK4's 4 (examples/, 100 s). The
-// predictor extrapolates the last step's stages: with A = f(q, v½) and
-// B = f(q⁺, v½) of the last step and B' the end stage before it, the next
-// f(q⁺, v⁺½) ≈ B + (A − B') — A − B' is the change of f with the last
-// velocity increment at nearly the same configuration, which the next one
-// repeats to O(h²) — an O(h³) guess instead of B's O(h²).
+// Sliding friction with a slip far below the speeds around it makes
+// ∂F/∂v large (docs/contacts.md, Known limits (2)); the fixed point then
+// diverges and the step fails saying so.
 #include "integrators/integrators_impl.hpp"
+
+#include <cmath>
 
 namespace appell::detail {
 
@@ -44,12 +58,16 @@ Leapfrog::Leapfrog(const Model& model, const IntegratorOptions& options)
       a_end_(model.nv),
       a_shift_(VecX::Zero(model.nv)),
       vh_(model.nv),
-      g_(model.nv),
-      res_(model.nv),
-      g_prev_(model.nv),
-      res_prev_(model.nv),
-      dF_(model.nv, kAndersonDepth),
-      dG_(model.nv, kAndersonDepth),
+      w_(model.nv),
+      y_(model.nv),
+      xp_(model.nv),
+      z_(2 * model.nv),
+      g_(2 * model.nv),
+      res_(2 * model.nv),
+      g_prev_(2 * model.nv),
+      res_prev_(2 * model.nv),
+      dF_(2 * model.nv, kAndersonDepth),
+      dG_(2 * model.nv, kAndersonDepth),
       q1_(model.nq) {}
 
 void Leapfrog::dropOldestPair() {
@@ -72,19 +90,59 @@ StepResult Leapfrog::step(AccelerationField& f, double& t, VecX& q, VecX& v, dou
     a_ = a_end_ + a_shift_;
   } else {
     ++r.evaluations;
-    if (!f(t, q, v, a_) || !a_.allFinite()) return failed(nullptr);
+    if (!f(t, q, v, a_) || !a_.allFinite()) return failed(nullptr);  // v is on the rows
   }
-  vh_ = v + (0.5 * h) * a_;
+  // The fixed point is on z = (x, Δ): x the half-step velocity, Δ its
+  // accumulated constraint impulse (M⁻¹Aᵀν at q). One map G(z):
+  //   w = v + ½h f(t, q, x),  y = w + Δ,  y ← constrainKick(t, q; t + ½h, q ⊕ ½h x)
+  //   G(z) = (y, y − w)
+  // whose fixed point is the half-kick with the discrete constraint
+  // A(q ⊕ ½h x) x + b = 0 (for an unconstrained field Δ stays 0).
+  const int n = model_.nv;
+  const bool constrained = f.constrained();
+  // The fixed points are the z with a zero residual at q ⊕ ½h x; Δ lies in
+  // the span of the rows' impulses at q only because every iterate's does.
+  // Differences carried from the last step hold impulses at the last q: with
+  // constraints the history starts afresh each step.
+  if (constrained) depth_ = 0;
+  z_.head(n) = v + (0.5 * h) * a_;
+  z_.tail(n).setZero();
   StageRates start{}, end{};
   bool converged = false;
-  double last_change = 0;
+  double last_change = 0, first_change = 0;
+  const char* diverged =
+      "the leapfrog's implicit half-step did not converge (the step is too large for the "
+      "velocity-dependent forces: ½h·|∂f/∂v| must stay below 1); use a smaller dt";
+  // F(q, x) = f(q, P_q x): f at the velocity's projection onto the rows at
+  // q. With redundant rows (a box flat on the ground) f exists only on the
+  // rows — off them their acceleration-level right sides disagree. Both
+  // kicks discard f's constraint part anyway (Δ absorbs it, the end
+  // projection removes it); what changes is that the velocity-dependent
+  // forces are taken at P_q x, which differs from x by O(h): the method stays
+  // consistent, and symmetric since F(q, −x) = F(q, x).
+  auto F = [&](double tt, const VecX& qq, const VecX& x, VecX& out) {
+    if (!constrained) return f(tt, qq, x, out);
+    xp_ = x;
+    return f.projectVelocity(tt, qq, xp_) && f(tt, qq, xp_, out);
+  };
   for (int k = 0; k < opt_.implicit_max_iterations && !converged; ++k) {
     ++r.evaluations;
-    if (!f(t, q, vh_, a_) || !a_.allFinite()) return failed(nullptr);
-    g_ = v + (0.5 * h) * a_;  // g(x) for x = vh_
-    res_ = g_ - vh_;          // the fixed point's residual
+    vh_ = z_.head(n);  // x
+    if (!F(t, q, vh_, a_) || !a_.allFinite())
+      return failed(k > 0 && last_change > first_change ? diverged : nullptr);
+    w_ = v + (0.5 * h) * a_;
+    g_.head(n) = w_ + z_.tail(n);
+    if (constrained) {
+      y_ = g_.head(n);
+      if (!f.constrainKick(t, q, h, y_)) return failed(nullptr);
+      g_.head(n) = y_;
+    }
+    g_.tail(n) = g_.head(n) - w_;
+    res_ = g_ - z_;  // the fixed point's residual
     const double change = res_.lpNorm<Eigen::Infinity>();
-    const double scale = 1 + g_.lpNorm<Eigen::Infinity>();
+    const double scale = 1 + g_.head(n).lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(change) || (k > 2 && change > 1e3 * first_change)) return failed(diverged);
+    if (k == 0) first_change = change;
     // Converged: at the tolerance, or stalled at the field's round-off
     // floor (the change stopped shrinking while already tiny).
     const double previous = last_change;
@@ -92,13 +150,14 @@ StepResult Leapfrog::step(AccelerationField& f, double& t, VecX& q, VecX& v, dou
                 (k > 0 && change > 0.5 * previous && change <= kRoundOffFloor * scale);
     last_change = change;
     if (converged) {
-      vh_.swap(g_);
+      z_.swap(g_);
       break;
     }
-    // Anderson mixing of depth ≤ kAndersonDepth: x⁺ = g − ΔG γ with γ the
+    // Anderson mixing of depth ≤ kAndersonDepth: z⁺ = G − ΔG γ with γ the
     // least-squares fit of the residual by its recent differences ΔF (each
-    // pair scaled to |ΔF| = 1, which leaves x⁺ alone and keeps the normal
-    // equations' conditioning that of the directions).
+    // pair scaled to |ΔF| = 1, which leaves z⁺ alone and keeps the normal
+    // equations' conditioning that of the directions). Mixing keeps Δ in
+    // the span of the rows' impulses: it only combines such Δs.
     // A mixing step that did not halve the residual: the history (carried
     // from the last step, or spoiled by round-off) is stale — restart.
     if (k > 0 && change > 0.5 * previous) depth_ = 0;
@@ -113,30 +172,28 @@ StepResult Leapfrog::step(AccelerationField& f, double& t, VecX& q, VecX& v, dou
     }
     res_prev_ = res_;
     g_prev_ = g_;
-    vh_ = g_;
+    z_ = g_;
     while (depth_ > 0) {
       const SmallMat gram = dF_.leftCols(depth_).transpose() * dF_.leftCols(depth_);
       const SmallVec rhs = dF_.leftCols(depth_).transpose() * res_;
       const Eigen::LDLT<SmallMat> ldlt(gram);
       const SmallVec gamma = ldlt.solve(rhs);
       if (ldlt.info() == Eigen::Success && gamma.allFinite() && ldlt.rcond() > 1e-10) {
-        vh_.noalias() -= dG_.leftCols(depth_) * gamma;
+        z_.noalias() -= dG_.leftCols(depth_) * gamma;
         break;
       }
       dropOldestPair();  // nearly dependent differences
     }
   }
-  if (!converged)
-    return failed(
-        "the leapfrog's implicit half-step did not converge (the step is too large for the "
-        "velocity-dependent forces: ½h·|∂f/∂v| must stay below 1); use a smaller dt");
+  if (!converged) return failed(diverged);
+  vh_ = z_.head(n);
   readRates(f, start);  // at (q, v½) of the last iterate
   // A − B' for the next predictor (B' is a_end_ until it is overwritten below).
   if (have_end_) a_shift_ = a_ - a_end_;
   else a_shift_.setZero();
   integrate(model_, q, vh_, h, q1_);
   ++r.evaluations;
-  if (!q1_.allFinite() || !f(t + h, q1_, vh_, a_end_) || !a_end_.allFinite()) {
+  if (!q1_.allFinite() || !F(t + h, q1_, vh_, a_end_) || !a_end_.allFinite()) {
     have_end_ = false;
     return failed(nullptr);
   }

@@ -3,6 +3,7 @@
 // integrator calls, and the per-contact workspace of the event handling.
 #pragma once
 
+#include <appell/configuration.hpp>
 #include <appell/simulator.hpp>
 
 #include <Eigen/LU>
@@ -81,7 +82,13 @@ struct UnilateralState {
 // integrator, which then rejects the step.
 class Simulator::Field final : public AccelerationField {
  public:
-  explicit Field(Simulator& s) : s_(s), tau_(VecX::Zero(s.model_.nv)) {}
+  explicit Field(Simulator& s)
+      : s_(s),
+        tau_(VecX::Zero(s.model_.nv)),
+        residual_(VecX::Zero(s.cdata_->m)),
+        residual_c_(VecX::Zero(s.cdata_->m)),
+        impulse_(VecX::Zero(s.cdata_->m)),
+        q_kick_(s.model_.nq) {}
 
   bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) override {
     Simulator& s = s_;
@@ -116,6 +123,41 @@ class Simulator::Field final : public AccelerationField {
     rates_[kSupportWork] = moving ? -stage_.lambda.dot(s.cdata_->b) : 0.0;
     return true;
   }
+  bool constrained() const override { return !s_.constraints_.empty(); }
+  bool projectVelocity(double t, const VecX& q, VecX& v) override {
+    Simulator& s = s_;
+    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
+    if (!s.solver_->projectVelocity(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, impulse_)) {
+      record("the leapfrog's velocity projection failed: " + s.solver_->lastError(), t);
+      return false;
+    }
+    return true;
+  }
+  // The leapfrog's discrete constraints (integrators.hpp): the residuals at
+  // the half-step point (velocity rows) and the gaps at the step's end over h
+  // (holonomic rows), removed by impulses along the rows at (t, q) — the rows
+  // at q with their offsets shifted by (those residuals − the residual at q),
+  // then the solver's own M-orthogonal projection.
+  bool constrainKick(double t, const VecX& q, double h, VecX& w) override {
+    Simulator& s = s_;
+    ConstraintData& cd = *s.cdata_;
+    integrate(s.model_, q, w, 0.5 * h, q_kick_);
+    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, cd, t + 0.5 * h, q_kick_, w);
+    velocityResiduals(*s.data_, s.constraints_, cd, w, residual_c_);
+    integrate(s.model_, q, w, h, q_kick_);
+    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, cd, t + h, q_kick_, w);
+    for (int i = 0; i < cd.m; ++i)
+      if (cd.holonomic[i] && cd.isActive(cd.row_constraint[i])) residual_c_[i] = cd.gap[i] / h;
+    evaluateConstraintRows(s.model_, *s.data_, s.constraints_, cd, t, q, w);
+    velocityResiduals(*s.data_, s.constraints_, cd, w, residual_);
+    residual_c_ -= residual_;
+    shiftRowOffsets(s.constraints_, cd, residual_c_);
+    if (!s.solver_->projectVelocity(s.model_, *s.data_, s.constraints_, cd, q, w, impulse_)) {
+      record("the leapfrog's constrained half-kick failed: " + s.solver_->lastError(), t);
+      return false;
+    }
+    return true;
+  }
   int rateCount() const override { return kWorkTerms; }
   double rate(int i) const override { return rates_[i]; }
 
@@ -137,6 +179,8 @@ class Simulator::Field final : public AccelerationField {
 
   Simulator& s_;
   VecX tau_;
+  VecX residual_, residual_c_, impulse_;  // constrainKick's (size m)
+  VecX q_kick_;                           // its half-step and end points
   ConstrainedResult stage_;
   std::array<double, kWorkTerms> rates_{};
   bool failed_ = false;
