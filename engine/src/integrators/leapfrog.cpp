@@ -94,10 +94,9 @@ StepResult Leapfrog::step(AccelerationField& f, double& t, VecX& q, VecX& v, dou
   }
   // The fixed point is on z = (x, Δ): x the half-step velocity, Δ its
   // accumulated constraint impulse (M⁻¹Aᵀν at q). One map G(z):
-  //   w = v + ½h f(t, q, x),  y = w + Δ,  y ← constrainKick(t, q; t + ½h, q ⊕ ½h x)
-  //   G(z) = (y, y − w)
-  // whose fixed point is the half-kick with the discrete constraint
-  // A(q ⊕ ½h x) x + b = 0 (for an unconstrained field Δ stays 0).
+  //   w = v + ½h F(t, q, x),  y = constrainKick(t, q, h; w + Δ),  G(z) = (y, y − w)
+  // whose fixed point is x = v + ½h F(q, x) + Δ with x meeting the discrete
+  // constraints (for an unconstrained field Δ stays 0).
   const int n = model_.nv;
   const bool constrained = f.constrained();
   // The fixed points are the z with a zero residual at q ⊕ ½h x; Δ lies in
