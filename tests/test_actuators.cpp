@@ -148,7 +148,7 @@ TEST(Actuators, DiffDriveDrivesStraightThenTheCommandedCircle) {
   ASSERT_TRUE(sim->advanceTo(3.0, o.dt).ok);
   const Motion m3 = motion();
   EXPECT_NEAR(m3.speed, 0.5, 1e-9);
-  EXPECT_NEAR(m3.yaw, 0, 1e-12);
+  EXPECT_NEAR(m3.yaw, 0, 5e-12);  // round-off over 3 s (rad/s); any asymmetry of the model shows orders above
   EXPECT_NEAR(sim->q()[1], 0, 1e-12);
   ASSERT_TRUE(sim->advanceTo(6.0, o.dt).ok);
   const Motion m6 = motion();

@@ -91,7 +91,7 @@ struct IntegratorOptions {
   double h_max = 0.1;        ///< adaptive: never step further
   double safety = 0.9;
   /// Leapfrog: the implicit half-step's fixed point stops when an iteration
-  /// moves v½ by less than implicit_tol · (1 + |v½|∞); it fails the step
+  /// moves (v½, its impulse) by less than implicit_tol · (1 + |v½|∞); it fails the step
   /// (h too large for the velocity-dependent forces) after
   /// implicit_max_iterations. Converging to round-off is what keeps the
   /// method symmetric.
@@ -121,8 +121,17 @@ class Integrator {
   /// methods). On success t, q, v are advanced; on failure they are untouched.
   virtual StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) = 0;
   /// Forget any state carried between steps (the FSAL stage); call after the
-  /// caller changes q or v itself (projection, an impulse).
+  /// caller changes q or v itself (an impulse, a new state).
   virtual void reset() {}
+  /// The caller moved the accepted state by (Δθ, Δv) — local coordinates
+  /// around the old q, and the velocity change — to put it back on the
+  /// constraints (the simulator's drift projection). By default that forgets
+  /// the carried stages, as reset(). Dormand–Prince keeps its FSAL stage when
+  /// the move is within its error tolerance (integrators.cpp).
+  virtual void stateMoved(const VecX& dtheta, const VecX& dv) {
+    (void)dtheta, (void)dv;
+    reset();
+  }
   /// Dense output of the last accepted step: the state at t₀ + s·h, s ∈ [0, 1]
   /// (a continuous extension of the method's own stages, no new evaluation).
   /// Returns false when the method has none or no step was accepted since.

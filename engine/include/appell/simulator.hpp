@@ -194,6 +194,7 @@ class Simulator {
 
   double t_ = 0, t_prev_ = 0;
   VecX q_, v_, q_prev_, v_prev_, tau_, impulse_;
+  VecX q_moved_, v_moved_, dtheta_moved_;  // the state before the drift projection, and the move
   ConstrainedResult result_;
   PositionProjectionResult projection_;
   double kinetic_ = 0, potential_ = 0, velocity_residual_ = 0, gap_residual_ = 0;

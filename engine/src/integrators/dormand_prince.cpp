@@ -132,6 +132,25 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
   }
 }
 
+// The FSAL stage k₇ = f(q, v) of the state before the move. Used as the next
+// step's k₁ at the moved state, it is off by ‖∂f/∂x‖·|move|, which enters
+// the next step as h b₁ ‖∂f/∂x‖ |move| — below the move itself for any step
+// the method can take stably, so a move within the error tolerance (the
+// same scaled RMS norm as the error control: the projection removing drift
+// the steps' own errors left) costs no accuracy, and keeping the stage saves
+// the seventh evaluation of the next step (issue 15, item 3).
+void DormandPrince54::stateMoved(const VecX& dtheta, const VecX& dv) {
+  if (!have_fsal_) return;
+  double sum = 0;
+  for (int i = 0; i < model_.nv; ++i) {
+    const double sq = opt_.atol + opt_.rtol * scale_q_[i];
+    const double sv = opt_.atol + opt_.rtol * std::abs(vs_[i]);
+    sum += std::pow(dtheta[i] / sq, 2) + std::pow(dv[i] / sv, 2);
+  }
+  const double moved = model_.nv > 0 ? std::sqrt(sum / (2.0 * model_.nv)) : 0.0;
+  if (!(moved <= 1.0)) have_fsal_ = false;
+}
+
 bool DormandPrince54::denseOutput(double s, VecX& q, VecX& v) {
   if (!dense_) return false;
   const double h = h_last_;

@@ -73,6 +73,7 @@ class DormandPrince54 final : public Integrator {
   bool adaptive() const override { return true; }
   StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) override;
   void reset() override { have_fsal_ = false; }
+  void stateMoved(const VecX& dtheta, const VecX& dv) override;
   bool denseOutput(double s, VecX& q, VecX& v) override;
 
  private:

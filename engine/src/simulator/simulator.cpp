@@ -33,6 +33,9 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   v_ = VecX::Zero(model_.nv);
   q_prev_ = q_;
   v_prev_ = v_;
+  q_moved_ = q_;
+  v_moved_ = v_;
+  dtheta_moved_ = VecX::Zero(model_.nv);
   tau_ = VecX::Zero(model_.nv);
   impulse_ = VecX::Zero(cdata_->m);
   result_.vdot = VecX::Zero(model_.nv);
@@ -83,7 +86,10 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   return state_error_.empty();
 }
 
-void Simulator::setJointForces(JointForces tau) { tau_fn_ = std::move(tau); }
+void Simulator::setJointForces(JointForces tau) {
+  tau_fn_ = std::move(tau);
+  integrator_->reset();  // a carried stage holds the old forces' acceleration
+}
 
 int Simulator::partitionChanges() const { return solver_->partitionChanges(); }
 
@@ -195,6 +201,13 @@ StepStatus Simulator::step(double h) {
   }
 
   // Drift control: positions onto the gaps, then velocities onto A v + b = 0.
+  // The integrator is told how far that moved the state (it may keep its
+  // FSAL stage for a move within its tolerance).
+  const bool projecting = options_.project_positions || options_.project_velocities;
+  if (projecting) {
+    q_moved_ = q_;
+    v_moved_ = v_;
+  }
   if (options_.project_positions) {
     projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
     st.projection_iterations = projection_.iterations;
@@ -207,7 +220,11 @@ StepStatus Simulator::step(double h) {
     if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_))
       return fail(st, "velocity projection failed: " + solver_->lastError());
   }
-  if (options_.project_positions || options_.project_velocities) integrator_->reset();
+  if (projecting) {
+    difference(model_, q_moved_, q_, dtheta_moved_);
+    v_moved_ = v_ - v_moved_;
+    integrator_->stateMoved(dtheta_moved_, v_moved_);
+  }
 
   std::string error;
   if (!evaluateEndState(error)) return fail(st, error);
