@@ -12,7 +12,14 @@
 //   turntable  a ball rolling on a turntable turning at 2 rad/s — a moving
 //              support (b ≠ 0), so not reversible under v → −v: the case where,
 //              after Modin & Verdier (Numer. Math. 145 (2020) 405–435),
-//              reversible methods lose their advantage.
+//              reversible methods lose their advantage. It keeps a reversing
+//              symmetry of another kind, though: a reflection through a
+//              vertical plane through the axis reverses the table's turning,
+//              and time reversal turns it back;
+//   springs    the same ball held by two horizontal springs anchored in the
+//              world at points not in one plane with the axis, stiffnesses
+//              3 and 5 N/m: no reflection maps the springs onto themselves,
+//              so no reversing symmetry is left.
 // The quantity watched is the work balance E + losses − work in − E₀ (the
 // energy for the first two; for the turntable the energy minus the table's
 // work), relative to E₀. Equal cost: each method's step is chosen from a
@@ -53,7 +60,20 @@ double cpuSeconds() {
 struct Problem {
   std::string name, what;
   BuiltScene scene;
+  Simulator::JointForces forces;  // empty: none
 };
+
+/// Two world-anchored springs on the ball's centre (the floating joint's
+/// origin): τ = (0, Rᵀ F), F = −Σ kᵢ (p − aᵢ), anchors at the centre's height.
+Simulator::JointForces twoSprings() {
+  return [](double, const VecX& q, const VecX&, VecX& tau) {
+    const Vec3 p = q.head<3>();
+    const Quat R(q[6], q[3], q[4], q[5]);
+    const Vec3 F = -3.0 * (p - Vec3(0.5, 0.0, 0.1)) - 5.0 * (p - Vec3(0.0, -0.4, 0.1));
+    tau.setZero();
+    tau.segment<3>(3) = R.conjugate() * F;
+  };
+}
 
 std::vector<Problem> problems() {
   RollingDiskParams d;
@@ -66,8 +86,10 @@ std::vector<Problem> problems() {
   s.turn_rate = 0.8;
   return {{"disk", "rolling disk, reversible integrable", rollingDisk(d)},
           {"sleigh", "Chaplygin sleigh on a 0.35 rad incline, reversible", sleigh(s)},
-          {"turntable", "ball on a turntable at 2 rad/s, moving support: not reversible",
-           ballOnTurntable(2.0)}};
+          {"turntable", "ball on a turntable at 2 rad/s, moving support: not reversible under v → −v",
+           ballOnTurntable(2.0)},
+          {"springs", "the same ball held by two asymmetric world-anchored springs: no reversing symmetry",
+           ballOnTurntable(2.0), twoSprings()}};
 }
 
 double balance(const Simulator& sim) {
@@ -83,16 +105,18 @@ struct Trace {
   std::string failure;         // empty when it ran to the end
 };
 
-std::unique_ptr<Simulator> makeSim(const BuiltScene& s, IntegratorType type) {
+std::unique_ptr<Simulator> makeSim(const Problem& p, IntegratorType type) {
+  const BuiltScene& s = p.scene;
   auto sim = std::make_unique<Simulator>(
       s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints), type);
+  if (p.forces) sim->setJointForces(p.forces);
   sim->setState(0, s.q0, s.v0);
   return sim;
 }
 
 /// Runs `steps` steps of h, sampling the balance error `samples` times on a
 /// logarithmic time grid (so every decade is seen).
-Trace run(const BuiltScene& s, IntegratorType type, double h, long steps, int samples) {
+Trace run(const Problem& s, IntegratorType type, double h, long steps, int samples) {
   auto sim = makeSim(s, type);
   const double E0 = balance(*sim);
   const double scale = std::max(1e-12, std::abs(E0));
@@ -128,7 +152,7 @@ Trace run(const BuiltScene& s, IntegratorType type, double h, long steps, int sa
 }
 
 /// CPU seconds per step, from a short run (median of three).
-double costPerStep(const BuiltScene& s, IntegratorType type, double h) {
+double costPerStep(const Problem& s, IntegratorType type, double h) {
   std::vector<double> c;
   for (int k = 0; k < 3; ++k) {
     const Trace tr = run(s, type, h, 3000, 1);
@@ -187,7 +211,7 @@ int main(int argc, char** argv) {
      << "of the dynamics (for the leapfrog each also projects its velocity onto the rows, and "
      << "each iteration of its first kick projects once more). Error: the largest "
      << "relative work-balance error |E + losses − work in − E₀|/E₀ up to each time "
-     << "(for the turntable the table's work is the work in). CPU time of the process.\n\n";
+     << "(for the turntable the table's and the springs' work is the work in). CPU time of the process.\n\n";
   const std::vector<double> marks = {10, 100, 1000, 10000, 100000};
   const struct {
     IntegratorType type;
@@ -196,7 +220,7 @@ int main(int argc, char** argv) {
                  {IntegratorType::RK4, "rk4"},
                  {IntegratorType::SymplecticEuler, "euler"}};
   for (const Problem& p : problems()) {
-    const double c_lf = costPerStep(p.scene, IntegratorType::Leapfrog, h);
+    const double c_lf = costPerStep(p, IntegratorType::Leapfrog, h);
     md << "## " << p.name << " — " << p.what << "\n\n| method | dt [s] | steps | CPU [s] | "
        << "evaluations per step |";
     for (double m : marks)
@@ -208,12 +232,12 @@ int main(int argc, char** argv) {
     for (const auto& m : methods) {
       double hm = h;
       if (m.type != IntegratorType::Leapfrog) {
-        const double c = costPerStep(p.scene, m.type, h);
+        const double c = costPerStep(p, m.type, h);
         hm = h * c / c_lf;  // equal CPU per simulated second
       }
       const long n = std::lround(T / hm);
       std::cout << p.name << ", " << m.name << ": dt " << hm << ", " << n << " steps" << std::flush;
-      const Trace tr = run(p.scene, m.type, hm, n, 60);
+      const Trace tr = run(p, m.type, hm, n, 60);
       std::cout << ", " << tr.cpu << " s CPU" << (tr.failure.empty() ? "" : " — " + tr.failure)
                 << "\n";
       md << "| " << m.name << " | " << sci(hm, 3) << " | " << tr.steps << " | "
@@ -233,11 +257,11 @@ int main(int argc, char** argv) {
   if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
     const std::string gp = out + "/long_run.gp";
     std::ofstream g(gp);
-    g << "set terminal pngcairo size 1500,450 font ',10'\nset output '" << out << "/long_run.png'\n"
+    g << "set terminal pngcairo size 1500,900 font ',10'\nset output '" << out << "/long_run.png'\n"
       << "set datafile separator ','\nset logscale xy\nset format y '10^{%L}'\nset format x '10^{%L}'\n"
       << "set xlabel 'simulated time [s]'\nset ylabel 'max relative work-balance error so far'\n"
-      << "set key top left\nset multiplot layout 1,3\n";
-    for (const char* p : {"disk", "sleigh", "turntable"}) {
+      << "set key top left\nset multiplot layout 2,2\n";
+    for (const char* p : {"disk", "sleigh", "turntable", "springs"}) {
       g << "set title '" << p << " (equal CPU per simulated second)'\nplot ";
       bool first = true;
       for (const char* m : {"leapfrog", "rk4", "euler"}) {
