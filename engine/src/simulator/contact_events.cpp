@@ -313,6 +313,7 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     // its slip stopped and it sticks if the cone allows (frictionPhase).
     if (type == detail::Crossing::Slip) {
       cdata_->setSliding(ev.c, false);
+      ev.redeciding = true;
     } else {  // at the cone's edge: slide against the sticking force
       evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
       tau_.setZero();
@@ -324,8 +325,9 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
       cdata_->setSliding(ev.c, true);
       logEvent(ContactEventKind::Slip, k, 0, 0, 0);
     }
-    if (!frictionPhase(error, type == detail::Crossing::Cone ? k : -1))
-      return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+    const bool phase_ok = frictionPhase(error, type == detail::Crossing::Cone ? k : -1);
+    ev.redeciding = false;
+    if (!phase_ok) return fail(st, "at t = " + std::to_string(t_) + ": " + error);
     if (type == detail::Crossing::Slip && !cdata_->isSliding(ev.c))
       logEvent(ContactEventKind::Stick, k, 0, 0, 0);
   } else if (!decideModes(error) || !frictionPhase(error)) {
@@ -667,7 +669,7 @@ bool Simulator::frictionPhase(std::string& error, int forced) {
       }
       r.dir_start = r.dir;
       cdata_->setSliding(r.c, true);
-      logEvent(ContactEventKind::Slip, k, 0, slip.norm(), 0);
+      if (!r.redeciding) logEvent(ContactEventKind::Slip, k, 0, slip.norm(), 0);
       change = k;
     }
     if (change < 0) return true;

@@ -257,7 +257,7 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
       r.dir_start = r.dir;
     }
     cdata_->setSliding(r.c, slides);
-    if (slides && !was) logEvent(ContactEventKind::Slip, k, 0, 0, 0);
+    if (slides && !was && !r.redeciding) logEvent(ContactEventKind::Slip, k, 0, 0, 0);
     if (!slides && was && k != forced) logEvent(ContactEventKind::Stick, k, 0, 0, 0);
   }
   return true;

@@ -46,6 +46,9 @@ struct UnilateralRow {
   // (its force is an unknown of the onset problem, not superposed).
   bool released = false;
   int first_force = 0;    // onset: index of its first friction row's unknown
+  // At a slip-reversal event: it was sliding and its mode and direction are
+  // decided afresh; sliding on (in a new direction) is not a new slip event.
+  bool redeciding = false;
 };
 
 /// What a unilateral constraint's crossing is (the event function located).
