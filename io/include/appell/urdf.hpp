@@ -86,6 +86,12 @@ struct InitialStateReport {
   double gap_residual = 0;        ///< max |g| over holonomic rows
   bool projected = false;         ///< q0/v0 were changed
   int iterations = 0;             ///< Newton steps of the position projection
+  /// Closed contacts with finite μ that slip at (q0, v0) by more than CAD
+  /// level (1e-6 of the largest velocity component, and more than `tol`): they
+  /// start sliding (a ball thrown with backspin), so only their normal rows
+  /// are checked. Slips below that are inconsistencies, checked as before.
+  /// Empty when projecting: then every row is made to hold (the contact rolls).
+  std::vector<std::string> sliding;
 };
 
 /// Checks that (q0, v0) satisfies every constraint: |A v + b| and the
