@@ -41,6 +41,19 @@ BuiltScene tiltedDisk() {
   return rollingDisk(p);
 }
 
+/// The seed sleigh on its incline, moving and turning.
+BuiltScene movingSleigh(bool reduced = false) {
+  SleighParams sp = seedSleighParams();
+  sp.speed = 0.6;
+  sp.turn_rate = 0.8;
+  return reduced ? sleighReduced(sp) : sleigh(sp);
+}
+
+struct NamedScene {
+  const char* name;
+  BuiltScene scene;
+};
+
 std::unique_ptr<Simulator> makeSim(const BuiltScene& s, IntegratorType type,
                                    const IntegratorOptions& o = {}) {
   auto sim = std::make_unique<Simulator>(
@@ -82,13 +95,8 @@ EnergyRecord runFixed(const BuiltScene& s, IntegratorType type, double h, int st
 // (no impulse in the first kick) misses by 10⁻³ on the disk; so does
 // carrying the fixed point's history across steps (leapfrog.cpp).
 TEST(Leapfrog, SimulatorStepIsTimeReversible) {
-  SleighParams sp = seedSleighParams();
-  sp.speed = 0.6;
-  sp.turn_rate = 0.8;
-  const struct {
-    const char* name;
-    BuiltScene scene;
-  } cases[] = {{"disk", tiltedDisk()}, {"sleigh", sleigh(sp)}, {"reduced sleigh", sleighReduced(sp)}};
+  const NamedScene cases[] = {
+      {"disk", tiltedDisk()}, {"sleigh", movingSleigh()}, {"reduced sleigh", movingSleigh(true)}};
   for (const auto& c : cases) {
     const BuiltScene& s = c.scene;
     auto sim = makeSim(s, IntegratorType::Leapfrog);
@@ -155,13 +163,7 @@ TEST(Leapfrog, RollingDiskEnergyStaysBoundedAtTenMilliseconds) {
 // passes between the motion and the height) and the Chaplygin ball (an
 // unbalanced-inertia ball rolling without slipping), 10 000 steps each.
 TEST(Leapfrog, SleighAndChaplyginBallEnergyStaysBounded) {
-  SleighParams sp = seedSleighParams();
-  sp.speed = 0.6;
-  sp.turn_rate = 0.8;
-  const struct {
-    const char* name;
-    BuiltScene scene;
-  } cases[] = {{"sleigh", sleigh(sp)}, {"Chaplygin ball", chaplyginBall()}};
+  const NamedScene cases[] = {{"sleigh", movingSleigh()}, {"Chaplygin ball", chaplyginBall()}};
   for (const auto& c : cases) {
     const EnergyRecord r = runFixed(c.scene, IntegratorType::Leapfrog, 1e-2, 10000);
     ASSERT_TRUE(r.ok) << c.name;
