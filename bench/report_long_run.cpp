@@ -84,10 +84,10 @@ std::vector<Problem> problems() {
   SleighParams s = seedSleighParams();
   s.speed = 0.6;
   s.turn_rate = 0.8;
-  return {{"disk", "rolling disk, reversible integrable", rollingDisk(d)},
-          {"sleigh", "Chaplygin sleigh on a 0.35 rad incline, reversible", sleigh(s)},
+  return {{"disk", "rolling disk, reversible integrable", rollingDisk(d), {}},
+          {"sleigh", "Chaplygin sleigh on a 0.35 rad incline, reversible", sleigh(s), {}},
           {"turntable", "ball on a turntable at 2 rad/s, moving support: not reversible under v → −v",
-           ballOnTurntable(2.0)},
+           ballOnTurntable(2.0), {}},
           {"springs", "the same ball held by two asymmetric world-anchored springs: no reversing symmetry",
            ballOnTurntable(2.0), twoSprings()}};
 }

@@ -1,10 +1,10 @@
 // The O(n) tree solver against the dense Udwadia–Kalaba reference
-// (test_tree_solver_common.hpp; the dense KKT solver: test_tree_solver_kkt.cpp):
+// (tree_solver_common.hpp; the dense KKT solver: test_tree_solver_kkt.cpp):
 // v̇ to 1e-10 relative, Aᵀλ, and the minimum-norm λ (redundant rows or not) —
 // on random trees with every joint type, fixed and
 // floating base, 1–6 rows per body, duplicated and scaled rows, rows a joint
 // cannot move, and singular poses; inconsistent rows give an error naming them.
-#include "test_tree_solver_common.hpp"
+#include "tree_solver_common.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 // over repeated solves must be zero — on random trees with redundant rows,
 // with loop rows (also redundant ones), and with rows handed up with their
 // compliance — the minimum-norm step included.
-#include "test_tree_solver_common.hpp"
+#include "tree_solver_common.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // multiplier reference: same v̇, Aᵀλ, rank and redundancy count, the same
 // minimum-norm λ (also when rows on different bodies are jointly redundant)
 // and impulse, and the same verdict on inconsistent rows.
-#include "test_tree_solver_common.hpp"
+#include "tree_solver_common.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,12 +1,12 @@
 // Joint-space rows on one one-DoF joint's velocity (joint limits) inside the
 // tree solver's passes (tree_solver/locked.cpp): a closed row locks its joint.
-// Against the dense Udwadia–Kalaba reference (test_tree_solver_common.hpp):
+// Against the dense Udwadia–Kalaba reference (tree_solver_common.hpp):
 // v̇, Aᵀλ and the minimum-norm λ on random trees with such rows next to
 // random body rows — duplicated, immobile and barely movable (compliant)
 // ones, two rows on one joint, rows redundant with a body row — and the
 // M-metric velocity projection; the rows are never loop rows, so a limit on
 // every joint costs O(1) each; disagreeing rows on one joint are named.
-#include "test_tree_solver_common.hpp"
+#include "tree_solver_common.hpp"
 
 #include <appell/joint_coupling.hpp>
 #include <appell/joint_limit.hpp>

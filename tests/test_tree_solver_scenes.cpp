@@ -5,7 +5,7 @@
 // and the minimum-norm λ agree with the long-double Udwadia–Kalaba reference
 // and the dense KKT solver to 1e-10, the rank agrees, and the projection
 // itself agrees with the dense one.
-#include "test_tree_solver_common.hpp"
+#include "tree_solver_common.hpp"
 
 #include "car_row.hpp"
 #include "fleet.hpp"

@@ -1,14 +1,9 @@
-// Random kinematic trees for tests and benchmarks: every joint type, random
-// placements and inertias (physically valid), fixed or floating base.
-#pragma once
-
-#include <appell/appell.hpp>
-
-#include <random>
+// The functions declared in random_tree.hpp, compiled once (see there for what they build).
+#include "random_tree.hpp"
 
 namespace appell::test {
 
-inline Inertia randomInertia(std::mt19937& rng) {
+Inertia randomInertia(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0.2, 2.0), c(-0.3, 0.3);
   // Principal moments from a random box (always satisfies the triangle inequality).
   const double m = u(rng), a = u(rng), b = u(rng), d = u(rng);
@@ -17,7 +12,7 @@ inline Inertia randomInertia(std::mt19937& rng) {
   return {m, Vec3(c(rng), c(rng), c(rng)), R * moments.asDiagonal() * R.transpose()};
 }
 
-inline SE3 randomPlacement(std::mt19937& rng) {
+SE3 randomPlacement(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   std::normal_distribution<double> g;
   SE3 X;
@@ -26,17 +21,15 @@ inline SE3 randomPlacement(std::mt19937& rng) {
   return X;
 }
 
-inline Vec3 randomUnit(std::mt19937& rng) {
+Vec3 randomUnit(std::mt19937& rng) {
   std::normal_distribution<double> g;
   return Vec3(g(rng), g(rng), g(rng)).normalized();
 }
 
-/// A random tree of n bodies; body i's parent is uniform in [−1 or 0, i−1].
-/// Joint types cycle through all moving types (plus a few fixed joints).
-inline Model randomTree(int n, bool floating_base, std::mt19937& rng) {
-  static constexpr JointType kinds[] = {JointType::Revolute, JointType::Prismatic,
-                                        JointType::Ball, JointType::Continuous,
-                                        JointType::Planar, JointType::Floating, JointType::Fixed};
+Model randomTree(int n, bool floating_base, std::mt19937& rng) {
+  static constexpr JointType kinds[] = {
+      JointType::Revolute, JointType::Prismatic, JointType::Ball, JointType::Continuous,
+      JointType::Planar,   JointType::Floating,  JointType::Fixed};
   ModelBuilder b;
   for (int i = 0; i < n; ++i) {
     int parent = -1;
@@ -51,7 +44,7 @@ inline Model randomTree(int n, bool floating_base, std::mt19937& rng) {
   return b.build();
 }
 
-inline VecX randomVector(int n, std::mt19937& rng, double scale = 1.0) {
+VecX randomVector(int n, std::mt19937& rng, double scale) {
   std::uniform_real_distribution<double> u(-scale, scale);
   VecX x(n);
   for (int i = 0; i < n; ++i) x[i] = u(rng);
