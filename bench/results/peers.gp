@@ -1,5 +1,5 @@
 # Work–precision figure of bench/results/peers.md; made by bench/peers/report_peers:
-#   build/bench/peers/report_peers --repeats 5 --out bench/results
+#   build/bench/peers/report_peers --repeats 3 --out bench/results
 set datafile separator ','
 set terminal pngcairo size 1500,560 noenhanced
 set output 'bench/results/peers.png'
