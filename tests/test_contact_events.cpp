@@ -409,6 +409,39 @@ TEST(ContactEvents, BilateralContactsHoldWhenPulled) {
   }
 }
 
+// Protects: watching for events changes nothing when none happens. The
+// watch evaluates the rows at each step's end to test for a feature switch,
+// and the drift projection then reuses those rows instead of evaluating them
+// again (their covectors, b and gaps depend on (q, t) only). The examples
+// with a moving support (turntable: b ≠ 0) and with four driven wheels run
+// the same states, to the bit, with events on and off.
+TEST(ContactEvents, TheEventWatchLeavesAnEventlessRunUnchanged) {
+  for (const char* name : {"ball_turntable/ball_turntable.urdf", "car/car.urdf"}) {
+    const Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/" + name);
+    std::vector<VecX> end(2);
+    for (int enabled = 0; enabled < 2; ++enabled) {
+      SimulatorOptions so;
+      so.contacts.enabled = enabled != 0;
+      Simulator sim(scene.model, scene.constraints,
+                    makeSolver(Formulation::Tree, scene.model, scene.constraints),
+                    IntegratorType::RK4, IntegratorOptions{}, so);
+      if (scene.tau.size() == scene.model.nv) {
+        const VecX tau = scene.tau;
+        sim.setJointForces([tau](double, const VecX&, const VecX&, VecX& out) { out = tau; });
+      }
+      ASSERT_TRUE(sim.setState(0, scene.q0, scene.v0));
+      for (int k = 0; k < 500; ++k) {
+        const StepStatus st = sim.step(2e-3);
+        ASSERT_TRUE(st.ok) << name << ": " << st.message;
+        ASSERT_EQ(st.events, 0) << name;
+      }
+      end[enabled].resize(scene.model.nq + scene.model.nv);
+      end[enabled] << sim.q(), sim.v();
+    }
+    EXPECT_EQ(end[0], end[1]) << name << ": max difference " << (end[0] - end[1]).lpNorm<Eigen::Infinity>();
+  }
+}
+
 // Protects: a rolling impact whose no-slip impulse leaves the friction cone
 // is reported (sliding impacts arrive with friction). The backspinning ball
 // of examples/bouncing_ball needs |Λₜ| = 0.43 N·s against Λₙ = 3.54 N·s at

@@ -228,11 +228,8 @@ TEST(CoreErrors, DuplicateJointNamesAndLongChains) {
   X.p = Vec3(0, 0, -1);
   int parent = -1;
   for (int i = 0; i < 100000; ++i)
-    // append, not "l" + std::to_string(i): GCC 12 warns falsely on the latter
-    // (-Wstringop-overflow, GCC bug 105329).
-    parent = b.addBody(std::string("l").append(std::to_string(i)), parent,
-                       parent < 0 ? SE3::Identity() : X, JointType::Revolute, Vec3::UnitY(), link,
-                       std::string("j").append(std::to_string(i)));
+    parent = b.addBody("l" + std::to_string(i), parent, parent < 0 ? SE3::Identity() : X, JointType::Revolute,
+                       Vec3::UnitY(), link, "j" + std::to_string(i));
   const Model m = b.build();
   EXPECT_EQ(m.nbodies, 100000);
   EXPECT_EQ(m.nv, 100000);

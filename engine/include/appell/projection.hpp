@@ -64,9 +64,13 @@ class PositionProjector {
   /// covectors and b are what the velocity projection needs; κ is not). Only the
   /// holonomic rows are assembled over v, into the projector's own workspace:
   /// `cdata` needs no dense storage. On failure q is left unchanged.
+  /// `rows_current`: `cdata` and `data` already hold evaluateConstraintRows at
+  /// (t, q) and some v — the covectors, b and gaps do not depend on v — so the
+  /// first evaluation is skipped (the simulator's feature-switch check has
+  /// just made it; when the gaps are within tolerance that was the whole cost).
   PositionProjectionResult project(const Model& model, Data& data,
                                    const ConstraintList& constraints, ConstraintData& cdata,
-                                   double t, VecX& q);
+                                   double t, VecX& q, bool rows_current = false);
   int holonomicRows() const;
   const ProjectionOptions& options() const;
 

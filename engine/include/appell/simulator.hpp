@@ -172,7 +172,9 @@ class Simulator {
   /// work_ after an integrator step from the last step's start.
   void takeStepWork(const StepResult& r);
   bool decideModes(std::string& error);
-  bool featureSwitchImpact(std::string& error);
+  /// `rows_current` on return: no impact, so cdata_/data_ still hold the rows
+  /// at the step's end (t_, q_, v_) that the check evaluated.
+  bool featureSwitchImpact(std::string& error, bool& rows_current);
   bool projectAfterModes(std::string& error);
   bool impactPhase(std::string& error);
   bool forcePhase(std::string& error);

@@ -144,7 +144,8 @@ const ProjectionOptions& PositionProjector::options() const { return impl_->opt;
 
 PositionProjectionResult PositionProjector::project(const Model& model, Data& data,
                                                     const ConstraintList& constraints,
-                                                    ConstraintData& cdata, double t, VecX& q) {
+                                                    ConstraintData& cdata, double t, VecX& q,
+                                                    bool rows_current) {
   Impl& w = *impl_;
   PositionProjectionResult res;
   if (q.size() != model.nq)
@@ -162,7 +163,7 @@ PositionProjectionResult PositionProjector::project(const Model& model, Data& da
   };
   double prev = std::numeric_limits<double>::infinity();
   for (int it = 0;; ++it) {
-    evaluateConstraintRows(model, data, constraints, cdata, t, q, w.v0);
+    if (it > 0 || !rows_current) evaluateConstraintRows(model, data, constraints, cdata, t, q, w.v0);
     if (cdata.singular) return fail("singular contact geometry: " + cdata.singular_reason);
     for (int k = 0; k < w.mh; ++k) {
       const int row = w.row_map[k];

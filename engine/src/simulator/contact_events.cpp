@@ -697,8 +697,9 @@ bool Simulator::decideModes(std::string& error) {
 /// impact: resolved here, at the step's end (not yet located inside the step),
 /// by the same impact and force problems as a touchdown, its energy loss
 /// counted — instead of being absorbed unseen by the drift projection.
-bool Simulator::featureSwitchImpact(std::string& error) {
+bool Simulator::featureSwitchImpact(std::string& error, bool& rows_current) {
   auto& u = *uni_;
+  rows_current = false;
   // The rows at the step's end; their forward kinematics (q, v) leave the
   // bodies' velocities in data_ for the normal velocities below.
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
@@ -711,9 +712,12 @@ bool Simulator::featureSwitchImpact(std::string& error) {
     if (r.b >= 0) gamma -= blk.Wb.row(r.row).dot(data_->oMi[r.b].act(data_->v[r.b]));
     approaching = approaching || gamma < -options_.contacts.rest_speed;
   }
-  if (!approaching) return true;
+  if (!approaching) {
+    rows_current = true;
+    return true;
+  }
   if (options_.project_positions) {
-    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_, true);
     if (!projection_.ok) {
       error = "position projection failed: " + projection_.error;
       return false;

@@ -194,9 +194,10 @@ StepStatus Simulator::step(double h) {
   }
   if (!std::isfinite(t_) || !q_.allFinite() || !v_.allFinite())
     return fail(st, "the integrator produced a non-finite state");
+  bool rows_current = false;  // cdata_ holds the rows at (t_, q_): the projection need not redo them
   if (uni_ && options_.contacts.enabled) {
     std::string error;
-    if (!featureSwitchImpact(error))
+    if (!featureSwitchImpact(error, rows_current))
       return fail(st, "at t = " + std::to_string(t_) + ": " + error);
   }
 
@@ -209,13 +210,13 @@ StepStatus Simulator::step(double h) {
     v_moved_ = v_;
   }
   if (options_.project_positions) {
-    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_);
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_, rows_current);
     st.projection_iterations = projection_.iterations;
     counters_.projection_iterations += projection_.iterations;
     if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
   }
   if (options_.project_velocities && cdata_->m_active > 0) {
-    if (!options_.project_positions)
+    if (!options_.project_positions && !rows_current)
       evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_))
       return fail(st, "velocity projection failed: " + solver_->lastError());
