@@ -151,15 +151,19 @@ Trace run(const Problem& s, IntegratorType type, double h, long steps, int sampl
   return tr;
 }
 
-/// CPU seconds per step, from a short run (median of three).
-double costPerStep(const Problem& s, IntegratorType type, double h) {
-  std::vector<double> c;
-  for (int k = 0; k < 3; ++k) {
-    const Trace tr = run(s, type, h, 3000, 1);
-    c.push_back(tr.cpu / std::max<long>(1, tr.steps));
+/// The CPU time per step of `type` relative to the leapfrog's at the same h:
+/// the median of five ratios, each from the two methods run back to back
+/// (10⁴ steps each), so that a change in the machine's load between the
+/// calibration runs does not end up in the equal-cost step.
+double costRatio(const Problem& s, IntegratorType type, double h) {
+  std::vector<double> r;
+  for (int k = 0; k < 5; ++k) {
+    const Trace a = run(s, type, h, 10000, 1);
+    const Trace b = run(s, IntegratorType::Leapfrog, h, 10000, 1);
+    r.push_back((a.cpu / std::max<long>(1, a.steps)) / (b.cpu / std::max<long>(1, b.steps)));
   }
-  std::sort(c.begin(), c.end());
-  return c[1];
+  std::sort(r.begin(), r.end());
+  return r[2];
 }
 
 std::string sci(double x, int p = 2) {
@@ -207,7 +211,7 @@ int main(int argc, char** argv) {
      << "\n\n"
      << "The leapfrog runs " << steps << " steps of " << h << " s; RK4 and symplectic Euler run "
      << "the same simulated time with the step that gives them the leapfrog's CPU time per "
-     << "simulated second (calibrated on 3000 steps, median of three). Evaluations: calls "
+     << "simulated second (calibrated against the leapfrog: the median of five CPU ratios, each from the two run back to back for 10⁴ steps). Evaluations: calls "
      << "of the dynamics (for the leapfrog each also projects its velocity onto the rows, and "
      << "each iteration of its first kick projects once more). Error: the largest "
      << "relative work-balance error |E + losses − work in − E₀|/E₀ up to each time "
@@ -220,7 +224,6 @@ int main(int argc, char** argv) {
                  {IntegratorType::RK4, "rk4"},
                  {IntegratorType::SymplecticEuler, "euler"}};
   for (const Problem& p : problems()) {
-    const double c_lf = costPerStep(p, IntegratorType::Leapfrog, h);
     md << "## " << p.name << " — " << p.what << "\n\n| method | dt [s] | steps | CPU [s] | "
        << "evaluations per step |";
     for (double m : marks)
@@ -232,8 +235,7 @@ int main(int argc, char** argv) {
     for (const auto& m : methods) {
       double hm = h;
       if (m.type != IntegratorType::Leapfrog) {
-        const double c = costPerStep(p, m.type, h);
-        hm = h * c / c_lf;  // equal CPU per simulated second
+        hm = h * costRatio(p, m.type, h);  // equal CPU per simulated second
       }
       const long n = std::lround(T / hm);
       std::cout << p.name << ", " << m.name << ": dt " << hm << ", " << n << " steps" << std::flush;

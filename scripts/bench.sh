@@ -10,11 +10,12 @@
 # Each page names the command that made it. The analyses in bench/RESULTS.md
 # and bench/results/*.md quote dated runs and link to these pages.
 #
-# One program at a time. Tried: running the 10⁶-step long run on one core
-# beside the others on the second (6 min instead of 8) moved the tree
-# solver's ratio to ABA at 1024 bodies from 2.20 to 3.02 (the two share the
-# memory bus) and the long run's equal-cost calibration by a third — not
-# figures to publish.
+# One program at a time: two at once share the memory bus as well as the
+# machine's other load. Tried: the 10⁶-step long run on one core beside the
+# rest on the other took 6 min instead of 8, and its tree-solver ratio at
+# 1024 bodies read 3.02 — within the spread these timings have anyway on a
+# shared machine (2.20–3.03 over four runs, three of them alone), so the
+# lanes bought 2 minutes at the price of one more source of noise.
 #   bash scripts/bench.sh          everything (≈ 8 min on 2 cores after the build)
 #   bash scripts/bench.sh NAME…    only those programs, one after another
 set -euo pipefail
