@@ -259,7 +259,9 @@ int main(int argc, char** argv) {
   if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
     const std::string gp = out + "/long_run.gp";
     std::ofstream g(gp);
-    g << "set terminal pngcairo size 1500,900 font ',10'\nset output '" << out << "/long_run.png'\n"
+    g << "# long_run.png, made by bench/report_long_run (its data: long_run.csv):\n#  ";
+    for (int i = 0; i < argc; ++i) g << " " << argv[i];
+    g << "\nset terminal pngcairo size 1500,900 font ',10'\nset output '" << out << "/long_run.png'\n"
       << "set datafile separator ','\nset logscale xy\nset format y '10^{%L}'\nset format x '10^{%L}'\n"
       << "set xlabel 'simulated time [s]'\nset ylabel 'max relative work-balance error so far'\n"
       << "set key top left\nset multiplot layout 2,2\n";

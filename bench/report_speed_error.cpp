@@ -139,7 +139,9 @@ int main(int argc, char** argv) {
   if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
     const std::string plot = out_dir + "/speed_error.gp";
     std::ofstream gp(plot);
-    gp << "set datafile separator ','\nset terminal pngcairo size 1100,600 noenhanced\n"
+    gp << "# speed_error.png, made by bench/report_speed_error (its data: speed_error.csv):\n#  ";
+    for (int i = 0; i < argc; ++i) gp << " " << argv[i];
+    gp << "\nset datafile separator ','\nset terminal pngcairo size 1100,600 noenhanced\n"
        << "set output '" << out_dir << "/speed_error.png'\n"
        << "set logscale xy\nset format y '1e%L'\nset format x '1e%L'\n"
        << "set xlabel 'wall time per simulated second [s]'\n"

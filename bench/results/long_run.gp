@@ -1,3 +1,5 @@
+# long_run.png, made by bench/report_long_run (its data: long_run.csv):
+#   build/bench/report_long_run --steps 1000000 --dt 0.01 --out bench/results
 set terminal pngcairo size 1500,900 font ',10'
 set output 'bench/results/long_run.png'
 set datafile separator ','

@@ -1,3 +1,5 @@
+# speed_error.png, made by bench/report_speed_error (its data: speed_error.csv):
+#   build/bench/report_speed_error --repeats 3 --out bench/results examples/rolling_disk/rolling_disk.urdf examples/sleigh/sleigh.urdf examples/hemisphere_bowl/hemisphere_bowl.urdf
 set datafile separator ','
 set terminal pngcairo size 1100,600 noenhanced
 set output 'bench/results/speed_error.png'
