@@ -125,6 +125,9 @@ void printContacts(std::ostream& out, const RunSummary& r) {
       out << ", friction demand max " << e.max_demand << " at t=" << e.t_max_demand;
       if (std::isfinite(e.mu)) out << " (μ = " << e.mu << ")";
     }
+    if (e.sliding_samples)
+      out << "; sliding in " << e.sliding_samples << " samples, slip speed max " << e.max_slip
+          << " m/s";
     if (e.over_mu)
       out << "  ⚠ exceeds μ in " << e.over_mu << " samples from t=" << e.first_slip << ": would slip";
     if (e.pulling)

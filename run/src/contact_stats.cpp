@@ -78,6 +78,11 @@ void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
       ++e.open_samples;
       continue;
     }
+    const int c = cdata.row_constraint[e.normal_row];
+    if (cdata.isSliding(c)) {
+      ++e.sliding_samples;
+      e.max_slip = std::max(e.max_slip, cdata.slide[c].slip.norm());
+    }
     const double fn = lambda[e.normal_row];
     double ft2 = 0;
     for (int r : e.tangential_rows) ft2 += lambda[r] * lambda[r];
@@ -97,7 +102,6 @@ void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
     }
     // Over μ is a finding only for a contact that is not sliding: a sliding
     // one carries μₖλₙ exactly (up to round-off, hence the 1e-9).
-    const int c = cdata.row_constraint[e.normal_row];
     if (!cdata.isSliding(c) && demand > e.mu * (1 + 1e-9) && e.over_mu++ == 0) e.first_slip = t;
   }
 }

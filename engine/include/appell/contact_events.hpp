@@ -84,6 +84,13 @@ struct ContactEventOptions {
   /// would unload into separating slower than this is held: a bouncing or
   /// rocking body comes to rest after finitely many impacts (docs/contacts.md §7).
   double rest_speed = 1e-3;
+  /// A sliding contact whose slip direction settles faster than this —
+  /// |s| / (μₖλₙ‖W‖) with W its rows' Delassus operator: a tiny slip that a
+  /// misaligned axle forces, a slip just starting — slides along its settled
+  /// direction, the force on the friction circle that makes the slip
+  /// accelerate along itself, instead of integrating that direction's
+  /// relaxation (rate 1/settle_time and faster: docs/contacts.md §8). 0: never.
+  double settle_time = 1e-6;
   int max_mode_iterations = 64;   ///< pivots of one complementarity problem
   int max_locate_iterations = 60; ///< root-finding iterations per event
 };

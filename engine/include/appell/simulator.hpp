@@ -68,6 +68,9 @@ struct SimulatorCounters {
   /// Friction onsets whose joint problem did not settle (its modes were then
   /// decided one contact at a time: docs/contacts.md §8).
   long friction_onset_unsettled = 0;
+  /// Solves whose sliding contacts' settled directions did not settle (they
+  /// then slid along their slips: friction_settled.cpp).
+  long settle_unsettled = 0;
 };
 
 class Simulator {
@@ -164,6 +167,8 @@ class Simulator {
                      ConstrainedResult& out, SolveOutputs outputs = SolveOutputs::All);
   bool frictionPhase(std::string& error, int forced = -1);
   bool frictionOnset(int forced, std::string& error);
+  bool solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
+                     ConstrainedResult& out, SolveOutputs outputs);
   Vec3 contactSlip(int k) const;
   Vec3 frictionForce(int k, const VecX& lambda) const;
   StepStatus locateAndHandleEvent(StepStatus st, double h);

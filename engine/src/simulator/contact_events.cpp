@@ -107,6 +107,20 @@ void Simulator::setUpUnilateral() {
   u.f = VecX::Zero(nf);
   u.f_old = VecX::Zero(nf);
   u.ln0 = VecX::Zero(kf);
+  u.tau_onset = VecX::Zero(model_.nv);
+  u.settle.reserve(u.rows.size());
+  u.sU = MatX::Zero(model_.nv, nf);
+  u.sW = MatX::Zero(nf, nf);
+  u.sN = MatX::Zero(kf, nf);
+  u.sa0 = VecX::Zero(nf);
+  u.sacc = VecX::Zero(nf);
+  u.sln0 = VecX::Zero(kf);
+  u.sln = VecX::Zero(kf);
+  u.sf = VecX::Zero(nf);
+  u.sf_old = VecX::Zero(nf);
+  u.stau = VecX::Zero(model_.nv);
+  u.swmax = VecX::Zero(kf);
+  u.sres = u.res;
 }
 
 // ---------------------------------------------------------------- detection

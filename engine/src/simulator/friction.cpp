@@ -33,7 +33,7 @@ using detail::UnilateralRow;
 /// the step's starting direction — a slip just starting from rest, where a
 /// stage's truncation error (O(h²ω²v) for a fast-spinning wheel) exceeds the
 /// slip itself — keeps the step's starting direction.
-static void slipDirection(const ConstraintData& cd, UnilateralRow& r, double floor) {
+void detail::slipDirection(const ConstraintData& cd, UnilateralRow& r, double floor) {
   const auto& sr = cd.slide[r.c];
   // Components beyond the contact's friction rows are zero throughout (the
   // rows' storage starts zero), so whole 3-vectors are used.
@@ -44,13 +44,24 @@ static void slipDirection(const ConstraintData& cd, UnilateralRow& r, double flo
 
 bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX& tau,
                               ConstrainedResult& out, SolveOutputs outputs) {
-  (void)t;
   auto* u = uni_.get();
   if (u) {
+    // Sliding contacts whose slip is small beside the state's speeds may
+    // slide on their settled directions (friction_settled.cpp).
+    const double screen = options_.contacts.settle_time > 0 && !u->settle_off
+                              ? detail::kSettleScreen * v.lpNorm<Eigen::Infinity>()
+                              : -1.0;
+    bool settling = false;
     u->sliding.clear();  // capacity reserved: no allocation
-    for (int k = 0; k < static_cast<int>(u->rows.size()); ++k)
-      if (cdata_->isActive(u->rows[k].c) && cdata_->isSliding(u->rows[k].c) && !u->rows[k].released)
-        u->sliding.push_back(k);
+    for (int k = 0; k < static_cast<int>(u->rows.size()); ++k) {
+      UnilateralRow& r = u->rows[k];
+      if (r.released) continue;
+      r.settling = false;
+      if (!cdata_->isActive(r.c) || !cdata_->isSliding(r.c)) continue;
+      u->sliding.push_back(k);
+      if (r.nf > 0 && cdata_->slide[r.c].slip.norm() <= screen) r.settling = settling = true;
+    }
+    if (settling) return solveSettling(t, q, v, tau, out, outputs);
   }
   if (u) u->friction_power = 0;
   if (!u || u->sliding.empty()) {
@@ -62,7 +73,7 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
   // spatial forces on A and B), with data_ at forwardKinematics(q, v).
   for (int j = 0; j < k; ++j) {
     UnilateralRow& r = u->rows[u->sliding[j]];
-    slipDirection(*cdata_, r, 10 * options_.contacts.speed_tol);
+    detail::slipDirection(*cdata_, r, 10 * options_.contacts.speed_tol);
     const auto& sr = cdata_->slide[r.c];
     const Vec3 f = -r.mu_k * r.dir;  // components along the friction rows (kinetic μ)
     auto g = u->G.col(j);

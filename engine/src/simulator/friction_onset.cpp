@@ -46,13 +46,11 @@ namespace appell {
 
 using detail::UnilateralRow;
 
-namespace {
-
 /// argmin ½ fᵀH f + cᵀf over |f| ≤ r in the first n (≤ 3) components, H
 /// symmetric positive semidefinite: the unconstrained (minimum-norm)
 /// minimizer when it lies inside, else f = −(H + νI)⁻¹c with ν > 0 on the
 /// circle (bisection on the monotone |f(ν)|).
-Vec3 diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
+Vec3 detail::diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
   if (!(r > 0)) return Vec3::Zero();
   Mat3 Hp = Mat3::Identity();
   Hp.topLeftCorner(n, n) = H.topLeftCorner(n, n);
@@ -90,8 +88,6 @@ Vec3 diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
   f.tail(3 - n).setZero();
   return f;
 }
-
-}  // namespace
 
 /// The slip velocity of unilateral row k's friction rows at data_'s
 /// velocities (a sliding contact's as evaluated; a sticking one's from its
@@ -191,8 +187,9 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
   // exact up to round-off relative to τ).
   const double scale = std::max(1.0, u.ln0.head(K).cwiseAbs().maxCoeff());
   for (int c = 0; c < F; ++c) {
-    u.tau_f = tau_ + scale * u.U.col(c);
-    if (!respond(u.tau_f, u.acc.head(F), u.f.head(K))) {
+    // (Its own vector: the solve superposes sliding friction in tau_f.)
+    u.tau_onset = tau_ + scale * u.U.col(c);
+    if (!respond(u.tau_onset, u.acc.head(F), u.f.head(K))) {
       restore();
       error = "friction modes: " + u.res.error;
       return false;
@@ -218,7 +215,7 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
       c.head(n) = u.a0.segment(o0, n);  // (products one by one: no temporaries)
       c.head(n).noalias() += u.W.block(o0, 0, n, F) * u.f.head(F);
       c.head(n).noalias() -= H.topLeftCorner(n, n) * u.f.segment(o0, n);
-      Vec3 fj = diskMinimizer(H, c, n, radius);
+      Vec3 fj = detail::diskMinimizer(H, c, n, radius);
       if (u.onset[j] == forced && fj.norm() < radius) {
         // At its slip event: on the cone, along the sticking force found
         // (or the one it had).

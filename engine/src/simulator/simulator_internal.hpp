@@ -17,6 +17,11 @@ namespace appell {
 
 namespace detail {
 
+/// A sliding contact is a candidate for its settled direction when its slip
+/// is at most this fraction of the state's largest speed (a screen only: the
+/// settling time decides, friction_settled.cpp).
+inline constexpr double kSettleScreen = 1e-2;
+
 /// Per unilateral constraint: where its row is, and a copy of that row as
 /// evaluated with the contact closed (an open contact's block holds zero
 /// rows), to measure its normal velocity and acceleration while it is open.
@@ -49,6 +54,10 @@ struct UnilateralRow {
   // At a slip-reversal event: it was sliding and its mode and direction are
   // decided afresh; sliding on (in a new direction) is not a new slip event.
   bool redeciding = false;
+  // Sliding on its settled direction (friction_settled.cpp): its friction
+  // force is an unknown of this solve, `settle_force` its first index.
+  bool settling = false;
+  int settle_force = 0;
 };
 
 /// What a unilateral constraint's crossing is (the event function located).
@@ -76,7 +85,24 @@ struct UnilateralState {
   MatX U, W, N;
   VecX a0, ln0, f, acc, f_old;
   std::vector<char> was_sliding;
+  VecX tau_onset;             // the onset's joint forces (tau_f is the sliding solve's)
+  // Sliding contacts on their settled directions (friction_settled.cpp),
+  // sized as the onset problem: the same unknowns, its own storage (an
+  // onset's solves may need it).
+  std::vector<int> settle;
+  bool settle_off = false;    // this solve slides every contact along its slip
+  MatX sU, sW, sN;
+  VecX sa0, sln0, sacc, sln, sf, sf_old, stau, swmax;
+  ConstrainedResult sres;
 };
+
+/// r.dir from the slip of sliding contact r, or the step's starting
+/// direction while the slip is below `floor` or reversed (friction.cpp).
+void slipDirection(const ConstraintData& cd, UnilateralRow& r, double floor);
+
+/// argmin ½ fᵀH f + cᵀf over |f| ≤ r in the first n (≤ 3) components, H
+/// symmetric positive semidefinite (friction_onset.cpp).
+Vec3 diskMinimizer(const Mat3& H, const Vec3& c, int n, double r);
 
 }  // namespace detail
 

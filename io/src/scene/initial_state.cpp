@@ -13,11 +13,6 @@ namespace appell {
 
 namespace {
 
-/// Slips below this fraction of the state's largest speed are CAD-level
-/// inconsistencies, not a sliding start (the friction issue's own bound on
-/// misalignment, 1e-6 rad).
-constexpr double kCadSlip = 1e-6;
-
 struct Worst {
   double value = 0;
   int row = -1;
@@ -91,15 +86,14 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
   }
   // A closed contact with finite μ that slips is not an error: it starts
   // sliding (the Simulator decides it so at setState), and only its normal
-  // row must hold. A slip at CAD level (≤ 1e-6 of the largest speed: an axle
-  // a micro-radian out of line) is not a motion the user meant but an
-  // inconsistency of the model, and is checked as before. Asked to project
-  // (--project-initial), the loader puts the state on every row instead: the
-  // user asked for the constraints to hold.
+  // row must hold — a slip at CAD level too (an axle a micro-radian out of
+  // line scrubs on its settled direction: docs/contacts.md §8). Asked to
+  // project (--project-initial), the loader puts the state on every row
+  // instead: the user asked for the constraints to hold.
   if (!project) {
     VecX residual;
     velocityResiduals(data, scene.constraints, cd, scene.v0, residual);
-    const double floor = std::max(tol, kCadSlip * scene.v0.lpNorm<Eigen::Infinity>());
+    const double floor = tol;
     for (int c = 0; c < static_cast<int>(scene.constraints.size()); ++c) {
       const Constraint& con = *scene.constraints[c];
       const auto& sr = cd.slide[c];

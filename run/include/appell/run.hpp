@@ -93,6 +93,10 @@ struct ContactStats {
   /// The friction demand exceeded μ or the normal pulled.
   bool flagged() const { return pulling > 0 || over_mu > 0; }
   long open_samples = 0;           ///< samples with the contact open (in flight)
+  /// Samples with the contact sliding, and its largest slip speed then (m/s:
+  /// a misaligned axle's scrub is its speed times the misalignment).
+  long sliding_samples = 0;
+  double max_slip = 0;
   /// The normal row moves nothing (the joints hold the contact's height, as a
   /// planar joint does a sleigh's): no normal load or friction demand to judge.
   bool normal_held = false;

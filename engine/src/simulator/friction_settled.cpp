@@ -1,0 +1,193 @@
+// Sliding contacts on their settled slip directions.
+//
+// A sliding contact's friction −μₖλₙ ŝ follows the direction of its slip s.
+// With the rest of the system, its slip evolves as
+//     ṡ = a + W f,        f = −μₖλₙ s/|s|,
+// a the slip acceleration without its friction, W its rows' Delassus
+// operator under the remaining constraints (friction_onset.cpp). The
+// direction of s turns at a rate of order μₖλₙ‖W‖/|s|: when the slip is
+// tiny beside that — an axle a micro-radian out of line scrubs at 10⁻⁶ of
+// the car's speed, 4·10⁸ s⁻¹ (docs/contacts.md §8) — the direction is a fast
+// variable and an explicit integrator crawls through its relaxation. Its
+// slow limit is algebraic (Tikhonov's theorem on singularly perturbed
+// systems; Kokotović, Khalil & O'Reilly, "Singular Perturbation Methods in
+// Control", 1986, ch. 1): the direction has settled when the slip
+// accelerates along itself, a + W f = −κ f with κ ≥ 0 and |f| = μₖλₙ, which
+// are the optimality conditions of
+//     min ½ fᵀW f + aᵀf   over   |f| ≤ μₖλₙ
+// with f on the circle — the maximal-dissipation problem the onset solves
+// at zero slip (Moreau 1988; Pfeiffer & Glocker 1996, §7.3), here for a slip
+// that is small but not zero. The error of the limit is the lag of the true
+// direction behind the settled one, about (settling time) × (its rate of
+// turning).
+//
+// So a sliding contact whose settling time |s| / (μₖλₙ‖W‖) is below
+// ContactEventOptions::settle_time takes the circle's force. One whose
+// minimizer lies inside the circle could stick: its slip decays within that
+// time and the stick event takes it (it slides on along its slip until
+// then). Each candidate's friction rows are released (as in the onset), W
+// and the loads' response N come from one solve per row force, the forces
+// from block Gauss–Seidel over the candidates' disks with the loads updated,
+// and the last solve applies them: F + 2 solves for F candidate rows, each
+// as the other sliding contacts need (friction.cpp). The reported friction
+// multipliers are the forces along the rows, as for every sliding contact.
+#include <appell/kinematics.hpp>
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_internal.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+
+namespace appell {
+
+using detail::UnilateralRow;
+
+bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
+                              ConstrainedResult& out, SolveOutputs outputs) {
+  auto& u = *uni_;
+  const double settle_time = options_.contacts.settle_time;
+  u.settle.clear();  // capacity reserved: no allocation
+  int F = 0;
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    UnilateralRow& r = u.rows[k];
+    if (!r.settling) continue;
+    r.settle_force = F;
+    F += r.nf;
+    r.released = true;  // its force is this solve's unknown
+    u.settle.push_back(k);
+  }
+  const int K = static_cast<int>(u.settle.size());
+  auto restore = [&] {
+    for (int j = 0; j < K; ++j) {
+      u.rows[u.settle[j]].released = false;
+      u.rows[u.settle[j]].settling = false;
+    }
+  };
+  // Generalized force per unit force along each candidate's friction rows.
+  for (int j = 0; j < K; ++j) {
+    const UnilateralRow& r = u.rows[u.settle[j]];
+    const auto& sr = cdata_->slide[r.c];
+    for (int i = 0; i < r.nf; ++i) {
+      auto col = u.sU.col(r.settle_force + i);
+      col.setZero();
+      if (r.a >= 0) {
+        spatialJacobianWorld(model_, *data_, r.a, u.J);
+        col.noalias() += u.J.transpose() * sr.Wa.row(i).transpose();
+      }
+      if (r.b >= 0) {
+        spatialJacobianWorld(model_, *data_, r.b, u.J);
+        col.noalias() -= u.J.transpose() * sr.Wb.row(i).transpose();
+      }
+    }
+  }
+  // The candidates' slip accelerations and normal loads at joint forces τ'
+  // (the other sliding contacts superposed as usual).
+  auto respond = [&](const VecX& tau_prime, Eigen::Ref<VecX> acc, Eigen::Ref<VecX> load) {
+    if (!solveDynamics(t, q, v, tau_prime, u.sres)) return false;
+    forwardKinematics(model_, *data_, q, v, u.sres.vdot);
+    for (int j = 0; j < K; ++j) {
+      const UnilateralRow& r = u.rows[u.settle[j]];
+      const auto& sr = cdata_->slide[r.c];
+      const Vec6 aa = r.a >= 0 ? spatialAccelerationWorld(*data_, r.a) : Vec6::Zero();
+      const Vec6 ab = r.b >= 0 ? spatialAccelerationWorld(*data_, r.b) : Vec6::Zero();
+      for (int i = 0; i < r.nf; ++i)
+        acc[r.settle_force + i] = sr.kappa[i] + sr.Wa.row(i).dot(aa) - sr.Wb.row(i).dot(ab);
+      load[j] = u.sres.lambda[r.global];
+    }
+    return true;
+  };
+  auto failed = [&] {
+    restore();
+    out.ok = false;
+    out.error = "sliding friction (settled directions): " + u.sres.error;
+    return false;
+  };
+  if (!respond(tau, u.sa0.head(F), u.sln0.head(K))) return failed();
+  const double scale = std::max(1.0, u.sln0.head(K).cwiseAbs().maxCoeff());
+  for (int c = 0; c < F; ++c) {
+    u.stau = tau + scale * u.sU.col(c);
+    if (!respond(u.stau, u.sacc.head(F), u.sln.head(K))) return failed();
+    u.sW.col(c).head(F) = (u.sacc.head(F) - u.sa0.head(F)) / scale;
+    u.sN.col(c).head(K) = (u.sln.head(K) - u.sln0.head(K)) / scale;
+  }
+  for (int j = 0; j < K; ++j) {
+    const UnilateralRow& r = u.rows[u.settle[j]];
+    Mat3 H = Mat3::Zero();
+    H.topLeftCorner(r.nf, r.nf) = u.sW.block(r.settle_force, r.settle_force, r.nf, r.nf);
+    H = 0.5 * (H + H.transpose()).eval();
+    u.swmax[j] = Eigen::SelfAdjointEigenSolver<Mat3>(H, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  }
+  // Block Gauss–Seidel over the candidates' disks, the loads updated as it
+  // sweeps. A candidate slow to settle, or whose minimizer is inside its
+  // circle, slides along its slip (its force then known, still affine in
+  // its load).
+  const double floor = 10 * options_.contacts.speed_tol;
+  u.sf.head(F).setZero();
+  bool settled = false;
+  for (int sweep = 0; sweep < 1000 && !settled; ++sweep) {
+    u.sf_old.head(F) = u.sf.head(F);
+    double fmax = 0;
+    for (int j = 0; j < K; ++j) {
+      UnilateralRow& r = u.rows[u.settle[j]];
+      const int o0 = r.settle_force, n = r.nf;
+      const double load = u.sln0[j] + u.sN.row(j).head(F).dot(u.sf.head(F));
+      const double radius = r.mu_k * std::max(0.0, load);
+      const double slip = cdata_->slide[r.c].slip.norm();
+      Vec3 fj = Vec3::Zero();
+      if (slip < settle_time * radius * u.swmax[j]) {
+        Mat3 H = Mat3::Zero();
+        H.topLeftCorner(n, n) = u.sW.block(o0, o0, n, n);
+        H = 0.5 * (H + H.transpose()).eval();
+        Vec3 c = Vec3::Zero();
+        c.head(n) = u.sa0.segment(o0, n);
+        c.head(n).noalias() += u.sW.block(o0, 0, n, F) * u.sf.head(F);
+        c.head(n).noalias() -= H.topLeftCorner(n, n) * u.sf.segment(o0, n);
+        fj = detail::diskMinimizer(H, c, n, radius);
+      }
+      if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
+        detail::slipDirection(*cdata_, r, floor);
+        fj = -radius * r.dir;
+      }
+      u.sf.segment(o0, n) = fj.head(n);
+      fmax = std::max(fmax, radius);
+    }
+    settled = sweep > 0 && (u.sf.head(F) - u.sf_old.head(F)).lpNorm<Eigen::Infinity>() <=
+                               1e-14 * std::max(fmax, 1e-300);
+  }
+  if (!settled) {
+    // Along their slips, as without this path (the loads still exact).
+    ++counters_.settle_unsettled;
+    restore();
+    u.settle_off = true;
+    const bool ok = solveDynamics(t, q, v, tau, out, outputs);
+    u.settle_off = false;
+    return ok;
+  }
+  // The last solve, with the candidates' forces applied.
+  u.stau = tau;
+  u.stau.noalias() += u.sU.leftCols(F) * u.sf.head(F);
+  if (!solveDynamics(t, q, v, u.stau, out, outputs)) {
+    restore();
+    return false;
+  }
+  double power = 0;
+  for (int c = 0; c < F; ++c) power -= u.sf[c] * u.sU.col(c).dot(v);
+  u.friction_power += power;  // beside the other sliding contacts'
+  for (int j = 0; j < K; ++j) {
+    UnilateralRow& r = u.rows[u.settle[j]];
+    const auto& sr = cdata_->slide[r.c];
+    const double fn = u.sf.segment(r.settle_force, r.nf).norm();
+    if (fn > 0) {
+      r.dir.setZero();
+      r.dir.head(r.nf) = -u.sf.segment(r.settle_force, r.nf) / fn;
+    }
+    if (outputs == SolveOutputs::All)
+      for (int i = 0; i < sr.n; ++i) out.lambda[cdata_->offset[r.c] + sr.row[i]] = u.sf[r.settle_force + i];
+  }
+  restore();
+  return true;
+}
+
+}  // namespace appell
