@@ -51,6 +51,11 @@ const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
   --max-residual R    stop when the constraint residual (max |Av+b|, |gap|)
                       exceeds R, keeping the last state within it (default
                       1e-6; inf switches the watch off)
+  --settle-time T     a sliding contact whose slip direction settles faster
+                      than T seconds slides on its settled direction (a
+                      misaligned axle's scrub, a slip just starting; error
+                      about T times that direction's turning rate); 0: the
+                      exact sliding law throughout (default 1e-4)
   --sweep NAME=START:STOP:COUNT
                       one run per value of a one-number override, on every
                       core (no trajectory): how each ended, its energy-balance
@@ -327,7 +332,7 @@ int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& a
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
-             "max-energy-error", "max-residual", "set", "sweep", "format"},
+             "max-energy-error", "max-residual", "settle-time", "set", "sweep", "format"},
             {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kRunHelp);
@@ -370,6 +375,12 @@ int run(int argc, char** argv) {
   if (args.has("max-residual"))
     options.max_residual = args.text("max-residual") == "inf" ? std::numeric_limits<double>::infinity()
                                                               : args.positiveNumber("max-residual", 1e-6);
+  if (args.has("settle-time")) {
+    options.settle_time = args.number("settle-time", options.settle_time);
+    if (!(options.settle_time >= 0) || !std::isfinite(options.settle_time))
+      throw UsageError("--settle-time must be a finite number ≥ 0 (seconds), not '" +
+                       args.text("settle-time") + "'");
+  }
   if (options.output_every < 1) throw UsageError("option --every must be at least 1");
   options.project_positions = options.project_velocities = !args.has("no-projection");
   if (args.has("sweep")) {

@@ -114,6 +114,7 @@ std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& o
   SimulatorOptions sopt;
   sopt.project_positions = options.project_positions;
   sopt.project_velocities = options.project_velocities;
+  sopt.contacts.settle_time = options.settle_time;
   auto sim = std::make_unique<Simulator>(
       scene.model, scene.constraints,
       makeSolver(options.formulation, scene.model, scene.constraints), options.integrator, iopt,

@@ -90,7 +90,7 @@ struct ContactEventOptions {
   /// direction, the force on the friction circle that makes the slip
   /// accelerate along itself, instead of integrating that direction's
   /// relaxation (rate 1/settle_time and faster: docs/contacts.md §8). 0: never.
-  double settle_time = 1e-6;
+  double settle_time = 1e-4;
   int max_mode_iterations = 64;   ///< pivots of one complementarity problem
   int max_locate_iterations = 60; ///< root-finding iterations per event
 };

@@ -19,6 +19,8 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   if (!solver_) throw std::invalid_argument("Simulator: no constrained solver given");
   for (const auto& c : constraints_)
     if (!c) throw std::invalid_argument("Simulator: the constraint list holds a null constraint");
+  if (!(options_.contacts.settle_time >= 0) || !std::isfinite(options_.contacts.settle_time))
+    throw std::invalid_argument("Simulator: contacts.settle_time must be finite and ≥ 0 (seconds)");
   data_ = std::make_unique<Data>(
       model_, solver_->usesDenseRows() ? MassMatrix::Sized : MassMatrix::None);
   // Dense storage (m × nv) only for the formulations that assemble A.

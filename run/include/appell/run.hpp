@@ -68,6 +68,9 @@ struct RunOptions {
   /// drift the projection no longer removes (or, with projection off, drift
   /// grown past what the user accepts). ∞ switches it off.
   double max_residual = 1e-6;
+  /// ContactEventOptions::settle_time: sliding contacts whose slip direction
+  /// settles faster slide on their settled directions (0: never).
+  double settle_time = ContactEventOptions{}.settle_time;
 };
 
 /// The scene's own settings as run options. Throws std::invalid_argument for
