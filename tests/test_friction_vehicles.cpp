@@ -445,6 +445,14 @@ TEST(FrictionVehicles, AMisalignedCarScrubsAndDrives) {
     // Dissipation |f| |s| integrated: with v = a t, ∫ |s| dt = ε x ft/|f_lat|.
     EXPECT_NEAR(sim->frictionWork(), ft * eps * x * ft / std::abs(l[6]), 1e-5 * sim->frictionWork());
     EXPECT_LT(balanceError(*sim, E0), 1e-12 * E0);
+    // The run summary reports the scrub: that tyre sliding in every sample,
+    // its largest slip the one at the end.
+    RunOptions o = runOptions(scene.settings);
+    const RunSummary r = runScene(scene, o);
+    ASSERT_TRUE(r.ok) << r.failure;
+    EXPECT_EQ(r.contacts[2].sliding_samples, r.samples);
+    EXPECT_NEAR(r.contacts[2].max_slip, slip, 1e-6 * slip);
+    EXPECT_EQ(r.contacts[3].sliding_samples, 0);
   }
 }
 
