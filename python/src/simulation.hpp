@@ -29,6 +29,7 @@ struct SimulationOptions {
   bool project_positions = true;
   bool project_velocities = true;
   bool contact_events = true;      ///< unilateral contacts may open (ContactEventOptions)
+  double settle_time = ContactEventOptions{}.settle_time;  ///< ContactEventOptions::settle_time
 };
 
 /// The states a stepping loop passed: one row per sample.

@@ -32,6 +32,8 @@ namespace appell {
 
 namespace detail {
 enum class Crossing;
+struct UnilateralRow;
+struct FrictionProblem;
 }
 
 struct SimulatorOptions {
@@ -169,6 +171,11 @@ class Simulator {
   bool frictionOnset(int forced, std::string& error);
   bool solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
                      ConstrainedResult& out, SolveOutputs outputs);
+  void frictionUnitForces(const std::vector<int>& rows, int detail::UnilateralRow::*first,
+                          detail::FrictionProblem& p);
+  bool frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,
+                         const std::vector<int>& rows, int detail::UnilateralRow::*first, int F,
+                         detail::FrictionProblem& p);
   Vec3 contactSlip(int k) const;
   Vec3 frictionForce(int k, const VecX& lambda) const;
   StepStatus locateAndHandleEvent(StepStatus st, double h);

@@ -99,28 +99,10 @@ void Simulator::setUpUnilateral() {
   for (const auto& r : u.rows) nf += r.nf;
   u.onset.reserve(u.rows.size());
   u.was_sliding.assign(u.rows.size(), 0);
-  u.U = MatX::Zero(model_.nv, nf);
-  u.W = MatX::Zero(nf, nf);
-  u.N = MatX::Zero(kf, nf);
-  u.a0 = VecX::Zero(nf);
-  u.acc = VecX::Zero(nf);
-  u.f = VecX::Zero(nf);
-  u.f_old = VecX::Zero(nf);
-  u.ln0 = VecX::Zero(kf);
-  u.tau_onset = VecX::Zero(model_.nv);
+  u.onset_problem.size(model_.nv, nf, kf, u.res);
   u.settle.reserve(u.rows.size());
-  u.sU = MatX::Zero(model_.nv, nf);
-  u.sW = MatX::Zero(nf, nf);
-  u.sN = MatX::Zero(kf, nf);
-  u.sa0 = VecX::Zero(nf);
-  u.sacc = VecX::Zero(nf);
-  u.sln0 = VecX::Zero(kf);
-  u.sln = VecX::Zero(kf);
-  u.sf = VecX::Zero(nf);
-  u.sf_old = VecX::Zero(nf);
-  u.stau = VecX::Zero(model_.nv);
+  u.settle_problem.size(model_.nv, nf, kf, u.res);
   u.swmax = VecX::Zero(kf);
-  u.sres = u.res;
 }
 
 // ---------------------------------------------------------------- detection

@@ -89,6 +89,65 @@ Vec3 detail::diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
   return f;
 }
 
+/// Column first + i of p.U: the generalized force of a unit force along
+/// friction row i of each of `ks`'s rows (row k's first unknown at k.*first),
+/// with data_ at the state's kinematics.
+void Simulator::frictionUnitForces(const std::vector<int>& ks, int UnilateralRow::*first,
+                                   detail::FrictionProblem& p) {
+  auto& u = *uni_;
+  for (int k : ks) {
+    const UnilateralRow& r = u.rows[k];
+    const auto& sr = cdata_->slide[r.c];
+    for (int i = 0; i < r.nf; ++i) {
+      auto col = p.U.col(r.*first + i);
+      col.setZero();
+      if (r.a >= 0) {
+        spatialJacobianWorld(model_, *data_, r.a, u.J);
+        col.noalias() += u.J.transpose() * sr.Wa.row(i).transpose();
+      }
+      if (r.b >= 0) {
+        spatialJacobianWorld(model_, *data_, r.b, u.J);
+        col.noalias() -= u.J.transpose() * sr.Wb.row(i).transpose();
+      }
+    }
+  }
+}
+
+/// The affine maps of the problem over `ks` (their F friction rows released
+/// by the caller): slip accelerations a0 + W f and normal loads ln0 + N f at
+/// (t, q, v) under τ + U f — one solve at τ and one per unit row force, at
+/// the scale of the loads (the map is affine: any scale is exact up to
+/// round-off relative to τ). false with p.res.error when a solve fails.
+bool Simulator::frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,
+                                  const std::vector<int>& ks, int UnilateralRow::*first, int F,
+                                  detail::FrictionProblem& p) {
+  const int K = static_cast<int>(ks.size());
+  auto respond = [&](const VecX& tau_prime, Eigen::Ref<VecX> acc, Eigen::Ref<VecX> load) {
+    if (!solveDynamics(t, q, v, tau_prime, p.res)) return false;
+    forwardKinematics(model_, *data_, q, v, p.res.vdot);
+    for (int j = 0; j < K; ++j) {
+      const UnilateralRow& r = uni_->rows[ks[j]];
+      const auto& sr = cdata_->slide[r.c];
+      const Vec6 aa = r.a >= 0 ? spatialAccelerationWorld(*data_, r.a) : Vec6::Zero();
+      const Vec6 ab = r.b >= 0 ? spatialAccelerationWorld(*data_, r.b) : Vec6::Zero();
+      for (int i = 0; i < r.nf; ++i)
+        acc[r.*first + i] = sr.kappa[i] + sr.Wa.row(i).dot(aa) - sr.Wb.row(i).dot(ab);
+      load[j] = p.res.lambda[r.global];
+    }
+    return true;
+  };
+  if (!respond(tau, p.a0.head(F), p.ln0.head(K))) return false;
+  const double scale = std::max(1.0, p.ln0.head(K).cwiseAbs().maxCoeff());
+  for (int c = 0; c < F; ++c) {
+    // (Its own vector: the solve superposes sliding friction in tau_f.)
+    p.tau = tau + scale * p.U.col(c);
+    if (!respond(p.tau, p.acc.head(F), p.load.head(K))) return false;
+    p.W.col(c).head(F) = (p.acc.head(F) - p.a0.head(F)) / scale;
+    p.N.col(c).head(K) = (p.load.head(K) - p.ln0.head(K)) / scale;
+  }
+  return true;
+}
+
 /// The slip velocity of unilateral row k's friction rows at data_'s
 /// velocities (a sliding contact's as evaluated; a sticking one's from its
 /// rows, before any projection).
@@ -144,77 +203,33 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
     }
   };
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  // Generalized force per unit force along each released row.
-  for (int j = 0; j < K; ++j) {
-    const UnilateralRow& r = u.rows[u.onset[j]];
-    const auto& sr = cdata_->slide[r.c];
-    for (int i = 0; i < r.nf; ++i) {
-      auto col = u.U.col(r.first_force + i);
-      col.setZero();
-      if (r.a >= 0) {
-        spatialJacobianWorld(model_, *data_, r.a, u.J);
-        col.noalias() += u.J.transpose() * sr.Wa.row(i).transpose();
-      }
-      if (r.b >= 0) {
-        spatialJacobianWorld(model_, *data_, r.b, u.J);
-        col.noalias() -= u.J.transpose() * sr.Wb.row(i).transpose();
-      }
-    }
-  }
-  // Slip accelerations and normal loads of the candidates at joint forces τ'.
-  auto respond = [&](const VecX& tau, Eigen::Ref<VecX> acc, Eigen::Ref<VecX> load) {
-    if (!solveDynamics(t_, q_, v_, tau, u.res)) return false;
-    forwardKinematics(model_, *data_, q_, v_, u.res.vdot);
-    for (int j = 0; j < K; ++j) {
-      const UnilateralRow& r = u.rows[u.onset[j]];
-      const auto& sr = cdata_->slide[r.c];
-      const Vec6 aa = r.a >= 0 ? spatialAccelerationWorld(*data_, r.a) : Vec6::Zero();
-      const Vec6 ab = r.b >= 0 ? spatialAccelerationWorld(*data_, r.b) : Vec6::Zero();
-      for (int i = 0; i < r.nf; ++i)
-        acc[r.first_force + i] = sr.kappa[i] + sr.Wa.row(i).dot(aa) - sr.Wb.row(i).dot(ab);
-      load[j] = u.res.lambda[r.global];
-    }
-    return true;
-  };
+  auto& p = u.onset_problem;
+  frictionUnitForces(u.onset, &UnilateralRow::first_force, p);
   tau_.setZero();
   if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
-  if (!respond(tau_, u.a0.head(F), u.ln0.head(K))) {
+  if (!frictionResponses(t_, q_, v_, tau_, u.onset, &UnilateralRow::first_force, F, p)) {
     restore();
-    error = "friction modes: " + u.res.error;
+    error = "friction modes: " + p.res.error;
     return false;
   }
-  // Unit forces at the scale of the loads (the map is affine: any scale is
-  // exact up to round-off relative to τ).
-  const double scale = std::max(1.0, u.ln0.head(K).cwiseAbs().maxCoeff());
-  for (int c = 0; c < F; ++c) {
-    // (Its own vector: the solve superposes sliding friction in tau_f.)
-    u.tau_onset = tau_ + scale * u.U.col(c);
-    if (!respond(u.tau_onset, u.acc.head(F), u.f.head(K))) {
-      restore();
-      error = "friction modes: " + u.res.error;
-      return false;
-    }
-    u.W.col(c).head(F) = (u.acc.head(F) - u.a0.head(F)) / scale;
-    u.N.col(c).head(K) = (u.f.head(K) - u.ln0.head(K)) / scale;
-  }
   // Block Gauss–Seidel, the loads updated as it goes.
-  u.f.head(F).setZero();
+  p.f.head(F).setZero();
   bool settled = false;
   for (int sweep = 0; sweep < 10000 && !settled; ++sweep) {
-    u.f_old.head(F) = u.f.head(F);
+    p.f_old.head(F) = p.f.head(F);
     double fmax = 0;
     for (int j = 0; j < K; ++j) {
       const UnilateralRow& r = u.rows[u.onset[j]];
       const int o0 = r.first_force, n = r.nf;
-      const double load = u.ln0[j] + u.N.row(j).head(F).dot(u.f.head(F));
+      const double load = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
       const double radius = r.mu * std::max(0.0, load);
       Mat3 H = Mat3::Zero();
-      H.topLeftCorner(n, n) = u.W.block(o0, o0, n, n);
+      H.topLeftCorner(n, n) = p.W.block(o0, o0, n, n);
       H = 0.5 * (H + H.transpose()).eval();
       Vec3 c = Vec3::Zero();
-      c.head(n) = u.a0.segment(o0, n);  // (products one by one: no temporaries)
-      c.head(n).noalias() += u.W.block(o0, 0, n, F) * u.f.head(F);
-      c.head(n).noalias() -= H.topLeftCorner(n, n) * u.f.segment(o0, n);
+      c.head(n) = p.a0.segment(o0, n);  // (products one by one: no temporaries)
+      c.head(n).noalias() += p.W.block(o0, 0, n, F) * p.f.head(F);
+      c.head(n).noalias() -= H.topLeftCorner(n, n) * p.f.segment(o0, n);
       Vec3 fj = detail::diskMinimizer(H, c, n, radius);
       if (u.onset[j] == forced && fj.norm() < radius) {
         // At its slip event: on the cone, along the sticking force found
@@ -222,10 +237,10 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
         const Vec3 d = fj.norm() > 0 ? Vec3(fj / fj.norm()) : Vec3(-r.dir);
         fj = radius * d;
       }
-      u.f.segment(o0, n) = fj.head(n);
+      p.f.segment(o0, n) = fj.head(n);
       fmax = std::max(fmax, radius);
     }
-    settled = sweep > 0 && (u.f.head(F) - u.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
+    settled = sweep > 0 && (p.f.head(F) - p.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
                                1e-14 * std::max(fmax, 1e-300);
   }
   restore();
@@ -235,17 +250,17 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
   }
   // Modes: a contact on its cone whose slip accelerates slides along that
   // acceleration, against its friction.
-  u.acc.head(F) = u.a0.head(F);
-  u.acc.head(F).noalias() += u.W.topLeftCorner(F, F) * u.f.head(F);
-  const double atol = 1e-9 * std::max(1.0, u.acc.head(F).lpNorm<Eigen::Infinity>());
+  p.acc.head(F) = p.a0.head(F);
+  p.acc.head(F).noalias() += p.W.topLeftCorner(F, F) * p.f.head(F);
+  const double atol = 1e-9 * std::max(1.0, p.acc.head(F).lpNorm<Eigen::Infinity>());
   for (int j = 0; j < K; ++j) {
     const int k = u.onset[j];
     UnilateralRow& r = u.rows[k];
     const int n = r.nf;
     Vec3 fj = Vec3::Zero(), aj = Vec3::Zero();
-    fj.head(n) = u.f.segment(r.first_force, n);
-    aj.head(n) = u.acc.segment(r.first_force, n);
-    const double load = u.ln0[j] + u.N.row(j).head(F).dot(u.f.head(F));
+    fj.head(n) = p.f.segment(r.first_force, n);
+    aj.head(n) = p.acc.segment(r.first_force, n);
+    const double load = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
     const bool on_cone = fj.norm() >= (1 - 1e-9) * r.mu * std::max(0.0, load);
     const bool slides = k == forced || (on_cone && aj.norm() > atol);
     const bool was = u.was_sliding[k] != 0;

@@ -65,57 +65,19 @@ bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX
       u.rows[u.settle[j]].settling = false;
     }
   };
-  // Generalized force per unit force along each candidate's friction rows.
-  for (int j = 0; j < K; ++j) {
-    const UnilateralRow& r = u.rows[u.settle[j]];
-    const auto& sr = cdata_->slide[r.c];
-    for (int i = 0; i < r.nf; ++i) {
-      auto col = u.sU.col(r.settle_force + i);
-      col.setZero();
-      if (r.a >= 0) {
-        spatialJacobianWorld(model_, *data_, r.a, u.J);
-        col.noalias() += u.J.transpose() * sr.Wa.row(i).transpose();
-      }
-      if (r.b >= 0) {
-        spatialJacobianWorld(model_, *data_, r.b, u.J);
-        col.noalias() -= u.J.transpose() * sr.Wb.row(i).transpose();
-      }
-    }
-  }
-  // The candidates' slip accelerations and normal loads at joint forces τ'
-  // (the other sliding contacts superposed as usual).
-  auto respond = [&](const VecX& tau_prime, Eigen::Ref<VecX> acc, Eigen::Ref<VecX> load) {
-    if (!solveDynamics(t, q, v, tau_prime, u.sres)) return false;
-    forwardKinematics(model_, *data_, q, v, u.sres.vdot);
-    for (int j = 0; j < K; ++j) {
-      const UnilateralRow& r = u.rows[u.settle[j]];
-      const auto& sr = cdata_->slide[r.c];
-      const Vec6 aa = r.a >= 0 ? spatialAccelerationWorld(*data_, r.a) : Vec6::Zero();
-      const Vec6 ab = r.b >= 0 ? spatialAccelerationWorld(*data_, r.b) : Vec6::Zero();
-      for (int i = 0; i < r.nf; ++i)
-        acc[r.settle_force + i] = sr.kappa[i] + sr.Wa.row(i).dot(aa) - sr.Wb.row(i).dot(ab);
-      load[j] = u.sres.lambda[r.global];
-    }
-    return true;
-  };
-  auto failed = [&] {
+  auto& p = u.settle_problem;
+  frictionUnitForces(u.settle, &UnilateralRow::settle_force, p);
+  // (The other sliding contacts superposed as usual in each solve.)
+  if (!frictionResponses(t, q, v, tau, u.settle, &UnilateralRow::settle_force, F, p)) {
     restore();
     out.ok = false;
-    out.error = "sliding friction (settled directions): " + u.sres.error;
+    out.error = "sliding friction (settled directions): " + p.res.error;
     return false;
-  };
-  if (!respond(tau, u.sa0.head(F), u.sln0.head(K))) return failed();
-  const double scale = std::max(1.0, u.sln0.head(K).cwiseAbs().maxCoeff());
-  for (int c = 0; c < F; ++c) {
-    u.stau = tau + scale * u.sU.col(c);
-    if (!respond(u.stau, u.sacc.head(F), u.sln.head(K))) return failed();
-    u.sW.col(c).head(F) = (u.sacc.head(F) - u.sa0.head(F)) / scale;
-    u.sN.col(c).head(K) = (u.sln.head(K) - u.sln0.head(K)) / scale;
   }
   for (int j = 0; j < K; ++j) {
     const UnilateralRow& r = u.rows[u.settle[j]];
     Mat3 H = Mat3::Zero();
-    H.topLeftCorner(r.nf, r.nf) = u.sW.block(r.settle_force, r.settle_force, r.nf, r.nf);
+    H.topLeftCorner(r.nf, r.nf) = p.W.block(r.settle_force, r.settle_force, r.nf, r.nf);
     H = 0.5 * (H + H.transpose()).eval();
     u.swmax[j] = Eigen::SelfAdjointEigenSolver<Mat3>(H, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
   }
@@ -124,36 +86,36 @@ bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX
   // circle, slides along its slip (its force then known, still affine in
   // its load).
   const double floor = 10 * options_.contacts.speed_tol;
-  u.sf.head(F).setZero();
+  p.f.head(F).setZero();
   bool settled = false;
   for (int sweep = 0; sweep < 1000 && !settled; ++sweep) {
-    u.sf_old.head(F) = u.sf.head(F);
+    p.f_old.head(F) = p.f.head(F);
     double fmax = 0;
     for (int j = 0; j < K; ++j) {
       UnilateralRow& r = u.rows[u.settle[j]];
       const int o0 = r.settle_force, n = r.nf;
-      const double load = u.sln0[j] + u.sN.row(j).head(F).dot(u.sf.head(F));
+      const double load = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
       const double radius = r.mu_k * std::max(0.0, load);
       const double slip = cdata_->slide[r.c].slip.norm();
       Vec3 fj = Vec3::Zero();
       if (slip < settle_time * radius * u.swmax[j]) {
         Mat3 H = Mat3::Zero();
-        H.topLeftCorner(n, n) = u.sW.block(o0, o0, n, n);
+        H.topLeftCorner(n, n) = p.W.block(o0, o0, n, n);
         H = 0.5 * (H + H.transpose()).eval();
         Vec3 c = Vec3::Zero();
-        c.head(n) = u.sa0.segment(o0, n);
-        c.head(n).noalias() += u.sW.block(o0, 0, n, F) * u.sf.head(F);
-        c.head(n).noalias() -= H.topLeftCorner(n, n) * u.sf.segment(o0, n);
+        c.head(n) = p.a0.segment(o0, n);
+        c.head(n).noalias() += p.W.block(o0, 0, n, F) * p.f.head(F);
+        c.head(n).noalias() -= H.topLeftCorner(n, n) * p.f.segment(o0, n);
         fj = detail::diskMinimizer(H, c, n, radius);
       }
       if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
         detail::slipDirection(*cdata_, r, floor);
         fj = -radius * r.dir;
       }
-      u.sf.segment(o0, n) = fj.head(n);
+      p.f.segment(o0, n) = fj.head(n);
       fmax = std::max(fmax, radius);
     }
-    settled = sweep > 0 && (u.sf.head(F) - u.sf_old.head(F)).lpNorm<Eigen::Infinity>() <=
+    settled = sweep > 0 && (p.f.head(F) - p.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
                                1e-14 * std::max(fmax, 1e-300);
   }
   if (!settled) {
@@ -166,25 +128,25 @@ bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX
     return ok;
   }
   // The last solve, with the candidates' forces applied.
-  u.stau = tau;
-  u.stau.noalias() += u.sU.leftCols(F) * u.sf.head(F);
-  if (!solveDynamics(t, q, v, u.stau, out, outputs)) {
+  p.tau = tau;
+  p.tau.noalias() += p.U.leftCols(F) * p.f.head(F);
+  if (!solveDynamics(t, q, v, p.tau, out, outputs)) {
     restore();
     return false;
   }
   double power = 0;
-  for (int c = 0; c < F; ++c) power -= u.sf[c] * u.sU.col(c).dot(v);
+  for (int c = 0; c < F; ++c) power -= p.f[c] * p.U.col(c).dot(v);
   u.friction_power += power;  // beside the other sliding contacts'
   for (int j = 0; j < K; ++j) {
     UnilateralRow& r = u.rows[u.settle[j]];
     const auto& sr = cdata_->slide[r.c];
-    const double fn = u.sf.segment(r.settle_force, r.nf).norm();
+    const double fn = p.f.segment(r.settle_force, r.nf).norm();
     if (fn > 0) {
       r.dir.setZero();
-      r.dir.head(r.nf) = -u.sf.segment(r.settle_force, r.nf) / fn;
+      r.dir.head(r.nf) = -p.f.segment(r.settle_force, r.nf) / fn;
     }
     if (outputs == SolveOutputs::All)
-      for (int i = 0; i < sr.n; ++i) out.lambda[cdata_->offset[r.c] + sr.row[i]] = u.sf[r.settle_force + i];
+      for (int i = 0; i < sr.n; ++i) out.lambda[cdata_->offset[r.c] + sr.row[i]] = p.f[r.settle_force + i];
   }
   restore();
   return true;

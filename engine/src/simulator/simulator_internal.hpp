@@ -60,6 +60,26 @@ struct UnilateralRow {
   int settle_force = 0;
 };
 
+/// The friction forces of a set of contacts as the unknowns of one problem
+/// (friction_onset.cpp, friction_settled.cpp), sized for every friction row:
+/// their generalized forces per unit row force U (nv × F), the slip
+/// accelerations' and normal loads' responses W (F × F) and N (K × F), the
+/// free terms a0 and ln0, the forces f, and the solves' workspace.
+struct FrictionProblem {
+  MatX U, W, N;
+  VecX a0, ln0, acc, load, f, f_old, tau;
+  ConstrainedResult res;
+  void size(int nv, int nf, int kf, const ConstrainedResult& like) {
+    U = MatX::Zero(nv, nf);
+    W = MatX::Zero(nf, nf);
+    N = MatX::Zero(kf, nf);
+    a0 = acc = f = f_old = VecX::Zero(nf);
+    ln0 = load = VecX::Zero(kf);
+    tau = VecX::Zero(nv);
+    res = like;
+  }
+};
+
 /// What a unilateral constraint's crossing is (the event function located).
 enum class Crossing { None, Gap, Normal, Cone, Slip };
 
@@ -82,18 +102,14 @@ struct UnilateralState {
   // slip accelerations' and normal loads' responses W (F × F), N (K × F),
   // the free terms, the forces and the modes before.
   std::vector<int> onset;
-  MatX U, W, N;
-  VecX a0, ln0, f, acc, f_old;
+  FrictionProblem onset_problem;
   std::vector<char> was_sliding;
-  VecX tau_onset;             // the onset's joint forces (tau_f is the sliding solve's)
-  // Sliding contacts on their settled directions (friction_settled.cpp),
-  // sized as the onset problem: the same unknowns, its own storage (an
-  // onset's solves may need it).
+  // Sliding contacts on their settled directions (friction_settled.cpp): the
+  // same unknowns, their own storage (an onset's solves may need it).
   std::vector<int> settle;
   bool settle_off = false;    // this solve slides every contact along its slip
-  MatX sU, sW, sN;
-  VecX sa0, sln0, sacc, sln, sf, sf_old, stau, swmax;
-  ConstrainedResult sres;
+  FrictionProblem settle_problem;
+  VecX swmax;                 // per candidate: the largest eigenvalue of its W block
 };
 
 /// r.dir from the slip of sliding contact r, or the step's starting
