@@ -213,11 +213,9 @@ namespace {
 // knuckles through <mimic multiplier="0.0625"> (a steering ratio of 16:1),
 // the knuckles turn about vertical axes through the front wheel centres, and
 // all four wheels roll on the ground (ideal rolling). The rear wheels are
-// driven with 1 N·m each (or by `drive`); `steer` is the hand wheel's
-// initial angle, `mu` the tyres' attributes (none: ideal rolling).
-constexpr const char* kRearTorques =
-    R"(<effort joint="rear_left_joint" value="1"/><effort joint="rear_right_joint" value="1"/>)";
-std::string steeredCar(double steer, const std::string& mu = "", const std::string& drive = kRearTorques) {
+// driven with 1 N·m each; `steer` is the hand wheel's initial angle (with
+// friction and actuators: examples/steered_car).
+std::string steeredCar(double steer) {
   auto wheel = [](const std::string& name) {
     return "<link name=\"" + name + R"("><inertial><mass value="1"/>
   <inertia ixx="0.005925" ixy="0" ixz="0" iyy="0.01125" iyz="0" izz="0.005925"/></inertial>
@@ -251,12 +249,12 @@ std::string steeredCar(double steer, const std::string& mu = "", const std::stri
          wheelJoint("rear_left_joint", "chassis", "rear_left", "-0.4 0.35 0") +
          wheelJoint("rear_right_joint", "chassis", "rear_right", "-0.4 -0.35 0") + R"(
 <appell><support name="ground" type="plane" normal="0 0 1" offset="0"/>
-  <contact name="fl" )" + mu + R"( link="front_left" kind="rolling" support="ground"/>
-  <contact name="fr" )" + mu + R"( link="front_right" kind="rolling" support="ground"/>
-  <contact name="rl" )" + mu + R"( link="rear_left" kind="rolling" support="ground"/>
-  <contact name="rr" )" + mu + R"( link="rear_right" kind="rolling" support="ground"/>
+  <contact name="fl" link="front_left" kind="rolling" support="ground"/>
+  <contact name="fr" link="front_right" kind="rolling" support="ground"/>
+  <contact name="rl" link="rear_left" kind="rolling" support="ground"/>
+  <contact name="rr" link="rear_right" kind="rolling" support="ground"/>
   <initial><joint name="root_joint" xyz="0 0 0.15"/><joint name="hand_wheel" position=")" + s + R"("/></initial>
-  )" + drive + R"(
+  <effort joint="rear_left_joint" value="1"/><effort joint="rear_right_joint" value="1"/>
 </appell></robot>)";
 }
 
@@ -294,11 +292,12 @@ TEST(Mimic, SteeredCarDrivesStraightAndReportsTheParallelSteeringLock) {
 }
 
 // Protects the issue's Ackermann linkage written with linear mimics, and the
-// friction issue's over-constrained vehicle: with μ = 0.9 the steered car
-// drives what its actuators command — a position servo holding the hand
-// wheel at 0.3 rad (1.07° at the knuckles) and velocity servos taking the
-// rear wheels from rest to 1 m/s (1.5 N·m at most: no wheelspin). The parallel knuckles miss Ackermann's by
-// 3·10⁻⁴ rad, so one front tyre must scrub: the outer one (fr) slides on its
+// friction issue's over-constrained vehicle (examples/steered_car): with
+// μ = 0.9 the same steered car drives what its actuators command — a
+// position servo holding the hand wheel at 0.3 rad (1.07° at the knuckles)
+// and velocity servos taking the rear wheels from rest to 1 m/s (1.5 N·m at
+// most: no wheelspin). The parallel knuckles miss Ackermann's by 3·10⁻⁴
+// rad, so one front tyre must scrub: the outer one (fr) slides on its
 // settled direction while the inner one (fl) and the rear tyres roll, and
 // the car drives the circle the inner wheel's Ackermann geometry gives —
 // yaw rate over the rear axle's speed 1/ρ, ρ = 0.35 + L/tan δ (the inner
@@ -306,11 +305,7 @@ TEST(Mimic, SteeredCarDrivesStraightAndReportsTheParallelSteeringLock) {
 // exact sliding law's relaxation, settle time 0, takes 10⁵ per second). The
 // work balance, friction included, closes to round-off.
 TEST(Mimic, ASteeredCarWithParallelKnucklesTurnsOnTheInnerWheelsCircle) {
-  const std::string drive = R"(
-  <actuator joint="rear_left_joint" type="velocity" kv="5" effort_limit="1.5" setpoint="6.666666666666667"/>
-  <actuator joint="rear_right_joint" type="velocity" kv="5" effort_limit="1.5" setpoint="6.666666666666667"/>
-  <actuator joint="hand_wheel" type="position" kp="5" kv="0.1" setpoint="0.3"/>)";
-  const Scene s = loadSceneFromString(steeredCar(0.3, R"(mu="0.9")", drive), ".", "steered_car.urdf");
+  const Scene s = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/steered_car/steered_car.urdf");
   RunOptions o = tight(Formulation::Tree);
   o.duration = 6.0;
   auto sim = makeSimulator(s, o);
