@@ -393,7 +393,7 @@ Scene misalignedCar(double yaw) {
 }
 
 std::unique_ptr<Simulator> carSimulator(const Scene& scene, Formulation f, double settle_time,
-                                        double tol = 1e-10) {
+                                        double tol = 1e-10, const SolverOptions& solver = {}) {
   IntegratorOptions iopt;
   iopt.rtol = tol;
   iopt.atol = 1e-2 * tol;
@@ -401,7 +401,7 @@ std::unique_ptr<Simulator> carSimulator(const Scene& scene, Formulation f, doubl
   SimulatorOptions sopt;
   sopt.contacts.settle_time = settle_time;
   auto sim = std::make_unique<Simulator>(scene.model, scene.constraints,
-                                         makeSolver(f, scene.model, scene.constraints),
+                                         makeSolver(f, scene.model, scene.constraints, solver),
                                          IntegratorType::DormandPrince54, iopt, sopt);
   sim->setJointForces(scene.jointForces());
   sim->setState(0.0, scene.q0, scene.v0);
@@ -485,4 +485,73 @@ TEST(FrictionVehicles, TheSettledScrubIsTheExactSlidingLimit) {
       << "the exact law is stiff";
   EXPECT_LT((tree->v() - exact->v()).lpNorm<Eigen::Infinity>(), 1e-9);
   EXPECT_LT((tree->lambda() - exact->lambda()).lpNorm<Eigen::Infinity>(), 1e-6 * 23.4);
+}
+
+// Protects the transition the settled scrub alone could not make (the
+// mimic issue's "drive, then turn"): sticking contacts that become
+// over-constrained while they move. With parallel knuckles at δ ≠ 0 the four
+// tyres have no common instantaneous centre: sticking would need internal
+// lateral forces growing like δ̇/δ, so a tyre must scrub from δ = 0⁺. The
+// rows count as redundant until their mismatch (∝ δ²) passes the solver's
+// consistency tolerance; there the solve fails, the over-constrained
+// direction of W picks the tyre whose cone fills first — the outer front
+// one — and the step is redone with it sliding (friction_overconstrained.cpp).
+// Before, the run stopped there with "inconsistent constraints". Checked:
+// one slip event, within 5 ms of the hand wheel starting; then the car
+// turns on the inner wheel's Ackermann circle ρ = t/2 + L/tan δ (the
+// rolling tyres' common centre) to 1e-9, with the outer tyre scrubbing on
+// its settled decelerating-or-growing direction without a crawl; the work
+// balance closes; and locating the event at a 1000× tighter consistency
+// tolerance moves the final state by the lag's effect only.
+TEST(FrictionVehicles, AParallelSteeredCarStartsToScrubWhenItsHandWheelTurnsAtSpeed) {
+  // examples/steered_car: parallel knuckles (both mimic the hand wheel, 1/16),
+  // driven from rest to 1 m/s with the hand wheel held straight, which turns
+  // to 0.3 rad (δ = 0.01875) over t = 2 … 2.5 s.
+  const Scene scene = loadScene(example("steered_car/steered_car.urdf"));
+  auto sim = carSimulator(scene, Formulation::Tree, 1e-4);
+  const double E0 = sim->energy();
+  const double T = 3.5;
+  const auto events = appell::test::advanceCollecting(*sim, T, 0.05);
+  ASSERT_NEAR(sim->time(), T, 1e-12);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, ContactEventKind::Slip);
+  EXPECT_EQ(scene.constraints[events[0].constraint]->name(), "fr") << "the outer front tyre";
+  EXPECT_GT(events[0].t, 2.0);
+  EXPECT_LT(events[0].t, 2.005);
+  EXPECT_EQ(sim->counters().overconstrained, 1);
+  EXPECT_LT(sim->counters().steps, 2000) << "no crawl";
+  const ConstraintData& cd = sim->constraintData();
+  EXPECT_FALSE(cd.isSliding(0));
+  EXPECT_TRUE(cd.isSliding(1));
+  EXPECT_FALSE(cd.isSliding(2));
+  EXPECT_FALSE(cd.isSliding(3));
+  const Model& m = scene.model;
+  const VecX& v = sim->v();
+  const double delta = sim->q()[m.joints[m.jointIndex("steer_left")].idx_q];
+  const double rho = 0.35 + 0.8 / std::tan(delta);
+  EXPECT_NEAR(delta, 0.01875, 1e-6);
+  EXPECT_NEAR(v[2] / v[3], 1 / rho, 1e-9 / rho) << "the inner wheel's circle";
+  EXPECT_NEAR(v[4], 0.4 * v[2], 1e-12) << "the rear axle rolls";
+  EXPECT_GT(sim->frictionWork(), 0);
+  EXPECT_LT(balanceError(*sim, E0), 1e-10 * E0);
+
+  SolverOptions tighter;
+  tighter.consistency_tol = 1e-11;
+  auto early = carSimulator(scene, Formulation::Tree, 1e-4, 1e-10, tighter);
+  const auto early_events = appell::test::advanceCollecting(*early, T, 0.05);
+  ASSERT_EQ(early_events.size(), 1u);
+  EXPECT_LT(early_events[0].t, 2.0005) << "located 10× nearer δ = 0⁺";
+  EXPECT_LT((early->q() - sim->q()).head(3).norm(), 1e-9) << "the lag's scrub is ∝ δ²";
+
+  // The dense formulations find the mismatch by their own rank tests (the
+  // event a little earlier or later) and agree on the rest.
+  for (Formulation f : {Formulation::Multipliers, Formulation::Appell}) {
+    auto other = carSimulator(scene, f, 1e-4);
+    const auto other_events = appell::test::advanceCollecting(*other, T, 0.05);
+    ASSERT_EQ(other_events.size(), 1u) << toString(f);
+    EXPECT_EQ(other_events[0].constraint, events[0].constraint) << toString(f);
+    EXPECT_NEAR(other_events[0].t, events[0].t, 5e-3) << toString(f);
+    EXPECT_LT((other->q() - sim->q()).head(3).norm(), 1e-9) << toString(f);
+    EXPECT_LT((other->v() - sim->v()).norm(), 1e-8) << toString(f);
+  }
 }

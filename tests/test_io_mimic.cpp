@@ -294,14 +294,15 @@ TEST(Mimic, SteeredCarDrivesStraightAndReportsTheParallelSteeringLock) {
 // Protects the Ackermann linkage written with linear mimics, and the
 // friction issue's over-constrained vehicle (examples/steered_car): with
 // μ = 0.9 the same steered car drives what its actuators command — a
-// position servo holding the hand wheel at 0.3 rad (1.07° at the knuckles)
-// and velocity servos taking the rear wheels from rest to 1 m/s (1.5 N·m at
-// most: no wheelspin). The parallel knuckles miss Ackermann's by 3·10⁻⁴
-// rad, so one front tyre must scrub: the outer one (fr) slides on its
+// velocity servos taking the rear wheels from rest to 1 m/s (1.5 N·m at
+// most: no wheelspin) while a position servo holds the hand wheel straight,
+// then turning it to 0.3 rad (1.07° at the knuckles) over 2 … 2.5 s. The
+// parallel knuckles miss Ackermann's by 3·10⁻⁴ rad, so one front tyre must
+// scrub (test_friction_vehicles.cpp follows the transition): the outer one (fr) slides on its
 // settled direction while the inner one (fl) and the rear tyres roll, and
 // the car drives the circle the inner wheel's Ackermann geometry gives —
 // yaw rate over the rear axle's speed 1/ρ, ρ = 0.35 + L/tan δ (the inner
-// axle line meeting the rear one), to 1e-9 — in under 500 steps for 6 s (the
+// axle line meeting the rear one), to 1e-9 — in under 2500 steps for 6 s at tol 1e-12 (the
 // exact sliding law's relaxation, settle time 0, takes 10⁵ per second). The
 // work balance, friction included, closes to round-off.
 TEST(Mimic, ASteeredCarWithParallelKnucklesTurnsOnTheInnerWheelsCircle) {
@@ -312,7 +313,7 @@ TEST(Mimic, ASteeredCarWithParallelKnucklesTurnsOnTheInnerWheelsCircle) {
   const double E0 = sim->energy();
   const StepStatus st = sim->advanceTo(6.0, 0.1);
   ASSERT_TRUE(st.ok) << st.message << " at t = " << sim->time();
-  EXPECT_LT(sim->counters().steps, 1000) << "no crawl (the exact law: ~6·10⁵)";
+  EXPECT_LT(sim->counters().steps, 2500) << "no crawl (the exact law: ~6·10⁵)";
   const ConstraintData& cd = sim->constraintData();
   EXPECT_FALSE(cd.isSliding(0)) << "fl rolls";
   EXPECT_TRUE(cd.isSliding(1)) << "fr scrubs";

@@ -242,7 +242,10 @@ TEST(Run, AHugeJointForceIsNamedAsTheCauseOfTheFailure) {
   std::ifstream in(std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf");
   const std::string car((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   auto withEffort = [&](const std::string& value) {
-    std::string xml = car;
+    // Ideal tyres: with μ = 0.9 the car flips over its spinning wheel and flies
+    // (a run that ends, 10⁶ steps for 0.01 s); rolling without slipping it
+    // cannot follow the force.
+    std::string xml = std::regex_replace(car, std::regex(R"( mu="0.9")"), "");
     const std::string anchor = "<simulation";
     xml.insert(xml.find(anchor), "<effort joint=\"front_left_joint\" value=\"" + value + "\"/>\n    ");
     return loadSceneFromString(xml, std::string(APPELL_SOURCE_DIR) + "/examples/car", "car.urdf");

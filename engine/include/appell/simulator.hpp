@@ -73,6 +73,9 @@ struct SimulatorCounters {
   /// Solves whose sliding contacts' settled directions did not settle (they
   /// then slid along their slips: friction_settled.cpp).
   long settle_unsettled = 0;
+  /// Steps redone because their sticking contacts became over-constrained
+  /// (one then slides: friction_overconstrained.cpp).
+  long overconstrained = 0;
 };
 
 class Simulator {
@@ -160,6 +163,8 @@ class Simulator {
  private:
   class Field;
   StepStatus fail(StepStatus st, std::string message);
+  /// One step from the current state (step() saved it as the step's start).
+  StepStatus attemptStep(double h);
   bool evaluateEndState(std::string& error);
   void restore();
   // Unilateral constraints (simulator/contact_events.cpp).
@@ -177,6 +182,10 @@ class Simulator {
                          const std::vector<int>& rows, int detail::UnilateralRow::*first, int F,
                          detail::FrictionProblem& p);
   Vec3 contactSlip(int k) const;
+  /// At a state where the sticking rows turned out inconsistent: the
+  /// unilateral row whose contact slides to resolve it (its dir set), or −1
+  /// (friction_overconstrained.cpp).
+  int overconstrainedContact(double t, const VecX& q, const VecX& v);
   Vec3 frictionForce(int k, const VecX& lambda) const;
   StepStatus locateAndHandleEvent(StepStatus st, double h);
   double eventFunction(int u, detail::Crossing type);

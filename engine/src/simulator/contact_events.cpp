@@ -103,6 +103,9 @@ void Simulator::setUpUnilateral() {
   u.settle.reserve(u.rows.size());
   u.settle_problem.size(model_.nv, nf, kf, u.res);
   u.swmax = VecX::Zero(kf);
+  u.over_W = MatX::Zero(nf, nf);
+  u.over_g = VecX::Zero(nf);
+  u.over_eig = Eigen::SelfAdjointEigenSolver<MatX>(nf);
 }
 
 // ---------------------------------------------------------------- detection

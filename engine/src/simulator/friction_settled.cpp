@@ -22,10 +22,14 @@
 // turning).
 //
 // So a sliding contact whose settling time |s| / (μₖλₙ‖W‖) is below
-// ContactEventOptions::settle_time takes the circle's force. One whose
-// minimizer lies inside the circle could stick: its slip decays within that
-// time and the stick event takes it (it slides on along its slip until
-// then). Each candidate's friction rows are released (as in the onset), W
+// ContactEventOptions::settle_time takes the circle's force. The stationary
+// directions come one per side of a soft direction of W: the minimizer
+// (κ ≥ 0: the slip grows along itself) and, for a slip that shrinks, the
+// stable root on its own side (settledForce below) — a parallel-steered
+// car's scrub when the hand wheel turns back, which the minimizer would
+// have flipped against the slip. A slip that its own friction brakes as
+// fast as it turns it stops before its direction settles: it slides along
+// its slip, and the stick event takes it. Each candidate's friction rows are released (as in the onset), W
 // and the loads' response N come from one solve per row force, the forces
 // from block Gauss–Seidel over the candidates' disks with the loads updated,
 // and the last solve applies them: F + 2 solves for F candidate rows, each
@@ -43,6 +47,100 @@
 namespace appell {
 
 using detail::UnilateralRow;
+
+namespace {
+
+/// The settled friction force of a slip on `side`: f on the circle |f| = r
+/// with c + H f = −κ f (H symmetric positive semidefinite in the first n
+/// components, eigenvalues λ₁ ≤ λ₂ ≤ …), the stable stationary direction of
+///     ŝ' = (1 − ŝŝᵀ)(c − r H ŝ) / |s|,   f = −r ŝ,
+/// whose slip ŝ = −f/r lies on side's half (ŝ·side > 0). Stable means H + κI
+/// positive on the plane across ŝ. In H's eigenbasis fᵢ = −cᵢ/(λᵢ + κ), and
+/// |f(κ)|² = Σ cᵢ²/(λᵢ + κ)² equals r² at one κ > −λ₁ (the upper root: the
+/// disk minimizer when κ ≥ 0, the slip growing along itself; κ < 0, the slip
+/// shrinking, when the minimizer is inside the circle) and at most at two in
+/// (−λ₂, −λ₁), convex there: the one nearest −λ₁ is stable, on the other
+/// side of e₁ (the slip shrinking along itself). Taken: the upper root with
+/// κ ≥ 0 on side's half; a shrinking root (κ < 0) within kSettledAlong of
+/// `side`. false otherwise: the slip's direction is not settled, and it
+/// slides along it.
+/// cos of the largest angle between a shrinking slip and its settled
+/// direction for that direction to be taken (settledForce).
+constexpr double kSettledAlong = 0.99;
+
+bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& side, Vec3& f) {
+  Mat3 Hp = Mat3::Zero();
+  Hp.topLeftCorner(n, n) = H.topLeftCorner(n, n);
+  Eigen::SelfAdjointEigenSolver<Mat3> es(Hp);
+  // The padded zero block's eigenvalues sit beside the real ones: keep the n
+  // whose eigenvectors lie in the first n components (ascending).
+  Vec3 lam = Vec3::Zero(), cq = Vec3::Zero();
+  Mat3 E = Mat3::Zero();
+  int m = 0;
+  for (int i = 0; i < 3 && m < n; ++i) {
+    if (es.eigenvectors().col(i).head(n).norm() < 0.5) continue;
+    lam[m] = std::max(es.eigenvalues()[i], 0.0);
+    E.col(m) = es.eigenvectors().col(i);
+    cq[m] = E.col(m).dot(c);
+    ++m;
+  }
+  const double cn = cq.norm();  // (its components past n are zero)
+  if (m != n || !(r > 0) || !(std::abs(cq[0]) > 1e-14 * cn)) return false;
+  auto norm2 = [&](double kappa) {
+    double s = 0;
+    for (int i = 0; i < n; ++i) s += cq[i] * cq[i] / ((lam[i] + kappa) * (lam[i] + kappa));
+    return s;
+  };
+  auto force = [&](double kappa) {
+    Vec3 fq = Vec3::Zero();
+    for (int i = 0; i < n; ++i) fq[i] = -cq[i] / (lam[i] + kappa);
+    Vec3 out = E * fq;
+    out.tail(3 - n).setZero();
+    return out;
+  };
+  // |f|² decreases from +∞ on (−λ₁, −λ₁ + |c|/r], where |f| ≤ r.
+  double a = -lam[0], b = -lam[0] + cn / r;
+  for (int it = 0; it < 200 && b - a > 1e-16 * (std::abs(a) + std::abs(b)); ++it) {
+    const double mid = 0.5 * (a + b);
+    (norm2(mid) > r * r ? a : b) = mid;
+  }
+  // A growing slip (κ ≥ 0) keeps its direction while it relaxes onto this
+  // one; a shrinking one may stop first — a slip that its own friction
+  // brakes, as much as it turns it, ends in a stick event, and its direction
+  // on the way is the exact law's — so it takes a shrinking branch only when
+  // it already points along it (within kSettledAlong).
+  f = force(b);
+  if (f.allFinite() && -f.dot(side) > (b >= 0 ? 0.0 : kSettledAlong * r)) return true;
+  // The lower root nearest −λ₁: right of |f|²'s minimum on (−λ₂, −λ₁) (one
+  // direction: on (−λ₁ − 2|c|/r, −λ₁), |f| < r at its left end).
+  const double hi = -lam[0];
+  double lo = n > 1 ? -lam[1] : hi - 2 * cn / r;
+  if (!(lo < hi)) return false;
+  a = lo;
+  b = hi;
+  if (n > 1) {  // the minimum: d|f|²/dκ = −2 Σ cᵢ²/(λᵢ + κ)³ increases
+    auto slope = [&](double kappa) {
+      double s = 0;
+      for (int i = 0; i < n; ++i) s -= cq[i] * cq[i] / std::pow(lam[i] + kappa, 3);
+      return s;
+    };
+    for (int it = 0; it < 200 && b - a > 1e-16 * (std::abs(a) + std::abs(b)); ++it) {
+      const double mid = 0.5 * (a + b);
+      (slope(mid) < 0 ? a : b) = mid;
+    }
+    a = 0.5 * (a + b);
+    if (!(norm2(a) <= r * r)) return false;
+    b = hi;
+  }
+  for (int it = 0; it < 200 && b - a > 1e-16 * (std::abs(a) + std::abs(b)); ++it) {
+    const double mid = 0.5 * (a + b);
+    (norm2(mid) < r * r ? a : b) = mid;
+  }
+  f = force(a);
+  return f.allFinite() && -f.dot(side) > kSettledAlong * r;
+}
+
+}  // namespace
 
 bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
                               ConstrainedResult& out, SolveOutputs outputs) {
@@ -106,7 +204,9 @@ bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX
         c.head(n) = p.a0.segment(o0, n);
         c.head(n).noalias() += p.W.block(o0, 0, n, F) * p.f.head(F);
         c.head(n).noalias() -= H.topLeftCorner(n, n) * p.f.segment(o0, n);
-        fj = detail::diskMinimizer(H, c, n, radius);
+        // The stable settled direction on the slip's own side.
+        detail::slipDirection(*cdata_, r, floor);
+        if (!settledForce(H, c, n, radius, r.dir, fj)) fj.setZero();  // along its slip (below)
       }
       if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
         detail::slipDirection(*cdata_, r, floor);

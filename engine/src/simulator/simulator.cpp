@@ -167,7 +167,6 @@ void Simulator::takeStepWork(const StepResult& r) {
 }
 
 StepStatus Simulator::step(double h) {
-  StepStatus st;
   if (!(h > 0) || !std::isfinite(h)) {
     std::ostringstream os;
     os << "Simulator::step: the step size must be positive and finite (got " << h << ")";
@@ -178,6 +177,28 @@ StepStatus Simulator::step(double h) {
   v_prev_ = v_;
   work_prev_ = work_;
   events_.clear();
+  StepStatus st = attemptStep(h);
+  // Sticking contacts that became over-constrained inside the step: one
+  // slides from the step's start, and the step is redone (at most once per
+  // unilateral constraint: friction_overconstrained.cpp).
+  for (int redo = 0; !st.ok && uni_ && options_.contacts.enabled && field_->solveFailed() &&
+                     redo < static_cast<int>(uni_->rows.size());
+       ++redo) {
+    const int k = overconstrainedContact(field_->failedT(), field_->failedQ(), field_->failedV());
+    if (k < 0) break;
+    --counters_.failed;  // fail() restored the step's start: not a failure after all
+    detail::UnilateralRow& row = uni_->rows[k];
+    row.dir_start = row.dir;
+    cdata_->setSliding(row.c, true);
+    logEvent(ContactEventKind::Slip, k, 0, 0, 0);
+    ++counters_.overconstrained;
+    st = attemptStep(h);
+  }
+  return st;
+}
+
+StepStatus Simulator::attemptStep(double h) {
+  StepStatus st;
   field_->clear();
   const StepResult r = integrator_->step(*field_, t_, q_, v_, h);
   takeStepWork(r);
@@ -220,8 +241,10 @@ StepStatus Simulator::step(double h) {
   if (options_.project_velocities && cdata_->m_active > 0) {
     if (!options_.project_positions && !rows_current)
       evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_))
+    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
+      field_->noteFailure(t_, q_, v_);
       return fail(st, "velocity projection failed: " + solver_->lastError());
+    }
   }
   if (projecting) {
     difference(model_, q_moved_, q_, dtheta_moved_);
@@ -230,7 +253,10 @@ StepStatus Simulator::step(double h) {
   }
 
   std::string error;
-  if (!evaluateEndState(error)) return fail(st, error);
+  if (!evaluateEndState(error)) {
+    field_->noteFailure(t_, q_, v_);
+    return fail(st, error);
+  }
   // Unilateral constraints: a gap or a normal force that changed sign over
   // the step means an event inside it (contact_events.cpp).
   detail::Crossing crossing = detail::Crossing::None;
@@ -240,6 +266,8 @@ StepStatus Simulator::step(double h) {
   } else if (uni_) {
     uni_->zero_events = 0;
     for (auto& row : uni_->rows) row.dir_start = row.dir;  // the next step's slip reference
+    st.events = static_cast<int>(events_.size());  // a slip at an over-constrained redo
+    counters_.events += st.events;
   }
   ++counters_.steps;
   return st;

@@ -6,6 +6,7 @@
 #include <appell/configuration.hpp>
 #include <appell/simulator.hpp>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include <limits>
@@ -110,6 +111,12 @@ struct UnilateralState {
   bool settle_off = false;    // this solve slides every contact along its slip
   FrictionProblem settle_problem;
   VecX swmax;                 // per candidate: the largest eigenvalue of its W block
+  // Over-constrained sticking contacts (friction_overconstrained.cpp), sized
+  // for every friction row: W padded, its eigen-solver, the part g of the
+  // free slip acceleration in W's null space.
+  MatX over_W;
+  VecX over_g;
+  Eigen::SelfAdjointEigenSolver<MatX> over_eig;
 };
 
 /// r.dir from the slip of sliding contact r, or the step's starting
@@ -133,7 +140,9 @@ class Simulator::Field final : public AccelerationField {
         residual_(VecX::Zero(s.cdata_->m)),
         residual_c_(VecX::Zero(s.cdata_->m)),
         impulse_(VecX::Zero(s.cdata_->m)),
-        q_kick_(s.model_.nq) {}
+        q_kick_(s.model_.nq),
+        q_fail_(s.model_.nq),
+        v_fail_(s.model_.nv) {}
 
   bool operator()(double t, const VecX& q, const VecX& v, VecX& vdot) override {
     Simulator& s = s_;
@@ -154,6 +163,7 @@ class Simulator::Field final : public AccelerationField {
     const bool moving = (s.cdata_->b.array() != 0).any();
     s.solveDynamics(t, q, v, tau_, stage_, moving ? SolveOutputs::All : SolveOutputs::Accelerations);
     if (!stage_.ok) {
+      if (!failed_) noteFailure(t, q, v);
       record(stage_.error, t);
       return false;
     }
@@ -208,9 +218,24 @@ class Simulator::Field final : public AccelerationField {
 
   void clear() {
     failed_ = false;
+    solve_failed_ = false;
     message_.clear();
   }
   bool failed() const { return failed_; }
+  /// A solve failed at (t, q, v) — a stage's, or the step's end state or
+  /// projection (Simulator::attemptStep): an over-constrained sticking set
+  /// is decided there (Simulator::step, friction_overconstrained.cpp).
+  void noteFailure(double t, const VecX& q, const VecX& v) {
+    solve_failed_ = true;
+    t_fail_ = t;
+    q_fail_ = q;
+    v_fail_ = v;
+  }
+  /// Whether a solve failed (then failedT/Q/V are its state).
+  bool solveFailed() const { return solve_failed_; }
+  double failedT() const { return t_fail_; }
+  const VecX& failedQ() const { return q_fail_; }
+  const VecX& failedV() const { return v_fail_; }
   const std::string& message() const { return message_; }
 
  private:
@@ -229,6 +254,9 @@ class Simulator::Field final : public AccelerationField {
   ConstrainedResult stage_;
   std::array<double, kWorkTerms> rates_{};
   bool failed_ = false;
+  bool solve_failed_ = false;
+  double t_fail_ = 0;
+  VecX q_fail_, v_fail_;
   std::string message_;
 };
 
