@@ -11,6 +11,8 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 using namespace appell;
 using namespace appell::scenes;
@@ -230,5 +232,65 @@ TEST(ContactFriction, PainleveRodIsReportedWithTheContactNamed) {
     EXPECT_GT(sim.lambda()[2], 0) << "the floor pushes";
     const StepStatus st = sim.step(1e-3);
     EXPECT_TRUE(st.ok) << st.message;
+  }
+}
+
+// Protects sliding impacts (the friction issue's second item): a ball
+// without spin thrown onto the plane at (2, 0, −1) m/s from 0.2 m above it,
+// μ = 0.1, restitution e = 0 or 0.5. Sticking through the impact would need
+// the tangential impulse (2/7) m s⁻ (s⁻ = 2 m/s the contact point's slip)
+// against μ Pₙ = μ (1 + e) m vₙ — outside the cone, so the ball slides
+// through the impact (friction_impact.cpp): v⁺ = v⁻ − μ (1 + e) vₙ,
+// ω⁺ = 5 μ (1 + e) vₙ / (2 r), the slip after it s⁻ − (7/2) μ (1 + e) vₙ
+// along the same direction; the impulse ratio is exactly μ (before, the
+// ball left rolling with a flagged impulse). Plastic, it then slides on and
+// sticks at t* = t₁ + s⁺/((7/2) μ g). The work balance, impacts and sliding
+// included, closes; the three formulations agree.
+TEST(ContactFriction, BallThrownOntoThePlaneSlidesThroughTheImpact) {
+  const double mu = 0.1, h = 0.2, vx = 2.0, vz = -1.0;
+  const double vn = std::sqrt(vz * vz + 2 * kG * h), t1 = (vz + vn) / kG;
+  for (double e : {0.0, 0.5}) {
+    for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+      BuiltScene s = ballWithFriction(mu, Vec3(vx, 0, vz), Vec3::Zero(), Vec3(0, 0, -kG));
+      ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+      spec.restitution = e;
+      s.constraints[0] = makeContact(spec);
+      s.q0[2] = kR + h;
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                    IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+      const double E0 = sim.energy();
+      std::vector<ContactEvent> events;
+      while (events.empty() && sim.time() < 1) {
+        const StepStatus st = sim.step(1e-2);
+        ASSERT_TRUE(st.ok) << st.message;
+        events = sim.events();
+      }
+      const std::string what = std::string(toString(f)) + ", e = " + std::to_string(e);
+      ASSERT_EQ(events.size(), 2u) << what;
+      EXPECT_EQ(events[0].kind, ContactEventKind::Slip) << what;
+      EXPECT_EQ(events[1].kind, e > 0 ? ContactEventKind::Bounce : ContactEventKind::Touchdown) << what;
+      EXPECT_NEAR(events[1].t, t1, 1e-10) << what;
+      const double pn = kM * (1 + e) * vn;
+      EXPECT_NEAR(events[1].normal_impulse, pn, 1e-10) << what;
+      EXPECT_NEAR(events[1].tangential_impulse, mu * pn, 1e-12) << what;
+      EXPECT_NEAR(centreVelocity(sim).x(), vx - mu * pn / kM, 1e-10) << what;
+      EXPECT_NEAR(centreVelocity(sim).z(), e * vn, 1e-10) << what;
+      EXPECT_NEAR(angularVelocity(sim).y(), 5 * mu * pn / (2 * kM * kR), 1e-9) << what;
+      const double slip = vx - 3.5 * mu * pn / kM;
+      if (e > 0) {
+        EXPECT_FALSE(sim.isClosed(0)) << what;
+        continue;
+      }
+      ASSERT_TRUE(sim.constraintData().isSliding(0)) << what;
+      EXPECT_NEAR(sim.constraintData().slide[0].slip.norm(), slip, 1e-10) << what;
+      const double t_stick = t1 + slip / (3.5 * mu * kG);
+      const auto later = appell::test::advanceCollecting(sim, t_stick + 0.1);
+      ASSERT_EQ(later.size(), 1u) << what;
+      EXPECT_EQ(later[0].kind, ContactEventKind::Stick) << what;
+      EXPECT_NEAR(later[0].t, t_stick, 1e-9) << what;
+      EXPECT_LT(std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - E0), 1e-9 * E0)
+          << what;
+    }
   }
 }

@@ -180,7 +180,10 @@ class Simulator {
                           detail::FrictionProblem& p);
   bool frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,
                          const std::vector<int>& rows, int detail::UnilateralRow::*first, int F,
-                         detail::FrictionProblem& p);
+                         detail::FrictionProblem& p, bool with_velocities = false);
+  /// An impact's friction impulses (friction_impact.cpp).
+  bool frictionImpact(std::string& error);
+  void shiftImpactTargets();
   Vec3 contactSlip(int k) const;
   /// At a state where the sticking rows turned out inconsistent: the
   /// unilateral row whose contact slides to resolve it (its dir set), or −1

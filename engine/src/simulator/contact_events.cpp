@@ -103,6 +103,7 @@ void Simulator::setUpUnilateral() {
   u.settle.reserve(u.rows.size());
   u.settle_problem.size(model_.nv, nf, kf, u.res);
   u.swmax = VecX::Zero(kf);
+  u.vstick = VecX::Zero(model_.nv);
   u.over_W = MatX::Zero(nf, nf);
   u.over_g = VecX::Zero(nf);
   u.over_eig = Eigen::SelfAdjointEigenSolver<MatX>(nf);
@@ -437,8 +438,20 @@ void Simulator::logEvent(ContactEventKind kind, int k, double before, double aft
   events_.push_back(e);
 }
 
+/// Shifts the closed impact rows so that the projection makes γ⁺ = −e γ⁻.
+void Simulator::shiftImpactTargets() {
+  for (auto& r : uni_->rows) {
+    if (!r.touching || !r.in_set) continue;
+    cdata_->b[r.global] += r.target;
+    RowBlock& blk = cdata_->blocks[r.c];
+    if (r.joint) blk.b_joint[r.row] += r.target;
+    else blk.b[r.row] += r.target;
+  }
+}
+
 /// Impact: Newton's law on the touching contacts that approach, with the
-/// velocity projection as the impulse solve, by principal pivoting.
+/// velocity projection as the impulse solve, by principal pivoting; then
+/// Coulomb's law on their friction impulses (friction_impact.cpp).
 bool Simulator::impactPhase(std::string& error) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
@@ -466,14 +479,7 @@ bool Simulator::impactPhase(std::string& error) {
     for (auto& r : u.rows)
       if (r.touching) cdata_->setActive(r.c, r.in_set);
     evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    for (auto& r : u.rows) {
-      if (!r.touching || !r.in_set) continue;
-      // Shift the row so that the projection makes γ⁺ = −e γ⁻.
-      cdata_->b[r.global] += r.target;
-      RowBlock& blk = cdata_->blocks[r.c];
-      if (r.joint) blk.b_joint[r.row] += r.target;
-      else blk.b[r.row] += r.target;
-    }
+    shiftImpactTargets();
     u.vplus = v_;
     if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
       error = "impact: the impulse solve failed: " + solver_->lastError();
@@ -499,6 +505,8 @@ bool Simulator::impactPhase(std::string& error) {
     std::swap(v_, u.vplus);  // back to the pre-impact velocity
     u.rows[flip].in_set = !u.rows[flip].in_set;
   }
+  // (u.vplus holds v⁻.)
+  if (!frictionImpact(error)) return false;
   // v_ is v⁺. Contacts that took an impulse with restitution rebound: open.
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
     auto& r = u.rows[k];

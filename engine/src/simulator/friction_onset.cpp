@@ -120,7 +120,7 @@ void Simulator::frictionUnitForces(const std::vector<int>& ks, int UnilateralRow
 /// round-off relative to τ). false with p.res.error when a solve fails.
 bool Simulator::frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,
                                   const std::vector<int>& ks, int UnilateralRow::*first, int F,
-                                  detail::FrictionProblem& p) {
+                                  detail::FrictionProblem& p, bool with_velocities) {
   const int K = static_cast<int>(ks.size());
   auto respond = [&](const VecX& tau_prime, Eigen::Ref<VecX> acc, Eigen::Ref<VecX> load) {
     if (!solveDynamics(t, q, v, tau_prime, p.res)) return false;
@@ -137,6 +137,7 @@ bool Simulator::frictionResponses(double t, const VecX& q, const VecX& v, const 
     return true;
   };
   if (!respond(tau, p.a0.head(F), p.ln0.head(K))) return false;
+  if (with_velocities) p.V.col(0) = p.res.vdot;  // (the base, until column 0's response)
   const double scale = std::max(1.0, p.ln0.head(K).cwiseAbs().maxCoeff());
   for (int c = 0; c < F; ++c) {
     // (Its own vector: the solve superposes sliding friction in tau_f.)
@@ -144,6 +145,11 @@ bool Simulator::frictionResponses(double t, const VecX& q, const VecX& v, const 
     if (!respond(p.tau, p.acc.head(F), p.load.head(K))) return false;
     p.W.col(c).head(F) = (p.acc.head(F) - p.a0.head(F)) / scale;
     p.N.col(c).head(K) = (p.load.head(K) - p.ln0.head(K)) / scale;
+    if (with_velocities) {
+      // Column c − 1 held the base: move it along (no extra storage).
+      if (c + 1 < F) p.V.col(c + 1) = p.V.col(c);
+      p.V.col(c) = (p.res.vdot - p.V.col(c)) / scale;
+    }
   }
   return true;
 }

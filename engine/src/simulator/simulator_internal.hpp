@@ -68,10 +68,12 @@ struct UnilateralRow {
 /// free terms a0 and ln0, the forces f, and the solves' workspace.
 struct FrictionProblem {
   MatX U, W, N;
+  MatX V;  // with_velocities: the generalized velocities' (v̇'s) response (nv × F)
   VecX a0, ln0, acc, load, f, f_old, tau;
   ConstrainedResult res;
   void size(int nv, int nf, int kf, const ConstrainedResult& like) {
     U = MatX::Zero(nv, nf);
+    V = MatX::Zero(nv, nf);
     W = MatX::Zero(nf, nf);
     N = MatX::Zero(kf, nf);
     a0 = acc = f = f_old = VecX::Zero(nf);
@@ -111,6 +113,7 @@ struct UnilateralState {
   bool settle_off = false;    // this solve slides every contact along its slip
   FrictionProblem settle_problem;
   VecX swmax;                 // per candidate: the largest eigenvalue of its W block
+  VecX vstick;                // an impact's post-impact velocity with every contact sticking
   // Over-constrained sticking contacts (friction_overconstrained.cpp), sized
   // for every friction row: W padded, its eigen-solver, the part g of the
   // free slip acceleration in W's null space.

@@ -1,0 +1,178 @@
+// Coulomb's law on an impact's friction impulses: sliding impacts.
+//
+// The impact phase (contact_events.cpp) finds the contacts in the impact
+// and their normal impulses by principal pivoting, each contact sticking:
+// its friction rows in the velocity projection, so the post-impact slip is
+// zero whatever tangential impulse that takes. Coulomb's law bounds that
+// impulse, |Pₜ| ≤ μ Pₙ — a ball dropped spinning on ice, a wheel landing
+// sideways, a foot striking at an angle slide through the impact — and a
+// contact that was sliding before takes no friction impulse there at all.
+//
+// So when a contact of the impact has friction and either was sliding or
+// took a tangential impulse outside its cone, the friction impulses of all
+// its contacts with friction are decided together, as the onset does for
+// forces (friction_onset.cpp; Moreau 1988, Glocker 2001 at the impulse
+// level): their friction rows released, the normal rows keeping Newton's
+// law γ⁺ = −e γ⁻, the post-impact slips, the normal impulses and the
+// velocities are affine in the friction impulses P,
+//     s⁺ = s⁰ + W P,    Pₙ = Pₙ⁰ + N P,    v⁺ = v⁰ + V P,
+// s⁰, Pₙ⁰, v⁰ from one projection without them, and W, N, V from one solve
+// per unit row force — the constrained response to a force is the response
+// to an impulse, the map being the same M-orthogonal projection (W is the
+// onset's Delassus operator). Maximal dissipation at the impulse level,
+//     min ½ PᵀW P + s⁰ᵀP   over   |Pⱼ| ≤ μⱼ Pₙⱼ,
+// by block Gauss–Seidel over the contacts' disks, the normal impulses
+// updated as it sweeps: a contact whose minimizer lies inside its static
+// disk sticks (s⁺ = 0), one on it slides through the impact with the kinetic
+// impulse μₖPₙ and leaves sliding along s⁺. A sliding contact's spin row
+// (rolling without spin) takes no impulse: spin friction is not modelled.
+// A normal impulse that the friction impulses would turn negative has no
+// consistent sliding impact (Painlevé's paradox at the impulse level:
+// Stewart, SIAM Review 42 (2000)): reported with the contact named.
+#include <appell/kinematics.hpp>
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_internal.hpp"
+
+#include <cmath>
+
+namespace appell {
+
+using detail::UnilateralRow;
+
+bool Simulator::frictionImpact(std::string& error) {
+  auto& u = *uni_;
+  const ContactEventOptions& o = options_.contacts;
+  // Here v_ = v⁺ with every contact sticking, u.vplus = v⁻, u.impulse the
+  // projection's multipliers (the push along a row is −impulse).
+  u.onset.clear();
+  int F = 0;
+  bool needed = false;
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    UnilateralRow& r = u.rows[k];
+    if (!r.touching || !r.in_set || r.nf == 0) continue;
+    const auto& sr = cdata_->slide[r.c];
+    double pt = 0;
+    for (int i = 0; i < sr.n; ++i) pt += std::pow(u.impulse[cdata_->offset[r.c] + sr.row[i]], 2);
+    needed = needed || cdata_->isSliding(r.c) ||
+             std::sqrt(pt) > r.mu * std::max(0.0, r.impulse) * (1 + 1e-9);
+    r.first_force = F;
+    F += r.nf;
+    u.onset.push_back(k);
+  }
+  if (!needed) return true;
+  const int K = static_cast<int>(u.onset.size());
+  u.vstick = v_;
+  u.vminus = u.vplus;
+  for (int k : u.onset) {
+    u.was_sliding[k] = cdata_->isSliding(u.rows[k].c);
+    cdata_->setSliding(u.rows[k].c, true);
+    u.rows[k].released = true;
+  }
+  auto restore = [&](bool keep_modes) {
+    for (int k : u.onset) {
+      u.rows[k].released = false;
+      if (!keep_modes) cdata_->setSliding(u.rows[k].c, u.was_sliding[k] != 0);
+    }
+  };
+  auto& p = u.onset_problem;
+  // The responses at (t, q, v⁻): they depend on q only.
+  v_ = u.vminus;
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  frictionUnitForces(u.onset, &UnilateralRow::first_force, p);
+  tau_.setZero();
+  if (!frictionResponses(t_, q_, v_, tau_, u.onset, &UnilateralRow::first_force, F, p, true)) {
+    restore(false);
+    v_ = u.vstick;
+    error = "impact with friction: " + p.res.error;
+    return false;
+  }
+  // Newton's law on the normal rows alone: v⁰ (in u.vplus), Pₙ⁰ (in p.ln0).
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  shiftImpactTargets();
+  u.vplus = v_;
+  if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
+    restore(false);
+    v_ = u.vstick;
+    error = "impact with friction: the impulse solve failed: " + solver_->lastError();
+    return false;
+  }
+  for (int j = 0; j < K; ++j) p.ln0[j] = -u.impulse[u.rows[u.onset[j]].global];
+  // s⁰: the released rows' slips at v⁰.
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, u.vplus);
+  for (int j = 0; j < K; ++j) {
+    const UnilateralRow& r = u.rows[u.onset[j]];
+    p.a0.segment(r.first_force, r.nf) = cdata_->slide[r.c].slip.head(r.nf);
+  }
+  // Block Gauss–Seidel over the disks, the normal impulses updated.
+  p.f.head(F).setZero();
+  bool settled = false;
+  for (int sweep = 0; sweep < 10000 && !settled; ++sweep) {
+    p.f_old.head(F) = p.f.head(F);
+    double fmax = 0;
+    for (int j = 0; j < K; ++j) {
+      const UnilateralRow& r = u.rows[u.onset[j]];
+      const int o0 = r.first_force, n = r.nf;
+      const double pn = std::max(0.0, p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F)));
+      Mat3 H = Mat3::Zero();
+      H.topLeftCorner(n, n) = p.W.block(o0, o0, n, n);
+      H = 0.5 * (H + H.transpose()).eval();
+      Vec3 c = Vec3::Zero();
+      c.head(n) = p.a0.segment(o0, n);
+      c.head(n).noalias() += p.W.block(o0, 0, n, F) * p.f.head(F);
+      c.head(n).noalias() -= H.topLeftCorner(n, n) * p.f.segment(o0, n);
+      Vec3 fj = detail::diskMinimizer(H, c, n, r.mu * pn);
+      if (fj.norm() >= (1 - 1e-12) * r.mu * pn) fj = detail::diskMinimizer(H, c, n, r.mu_k * pn);
+      p.f.segment(o0, n) = fj.head(n);
+      fmax = std::max(fmax, r.mu * pn);
+    }
+    settled = sweep > 0 && (p.f.head(F) - p.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
+                               1e-14 * std::max(fmax, 1e-300);
+  }
+  if (!settled) {
+    // Keep the sticking impact (its cone excess is then reported).
+    ++counters_.friction_onset_unsettled;
+    restore(false);
+    v_ = u.vstick;
+    forwardKinematics(model_, *data_, q_, v_);
+    return true;
+  }
+  // v⁺ = v⁰ + V P; the impulses for the log; the modes after the impact.
+  v_ = u.vplus;
+  v_.noalias() += p.V.leftCols(F) * p.f.head(F);
+  p.acc.head(F) = p.a0.head(F);
+  p.acc.head(F).noalias() += p.W.topLeftCorner(F, F) * p.f.head(F);
+  for (int j = 0; j < K; ++j) {
+    const int k = u.onset[j];
+    UnilateralRow& r = u.rows[k];
+    const auto& sr = cdata_->slide[r.c];
+    const double pn = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
+    if (pn < -o.force_tol) {
+      restore(false);
+      v_ = u.vstick;
+      error = "impact with friction: the friction impulses would pull contact '" +
+              constraints_[r.c]->name() +
+              "' off the support (a Painlevé-type impact: no consistent sliding impact)";
+      return false;
+    }
+    r.impulse = pn;
+    u.impulse[r.global] = -pn;
+    for (int i = 0; i < sr.n; ++i) u.impulse[cdata_->offset[r.c] + sr.row[i]] = -p.f[r.first_force + i];
+    Vec3 slip = Vec3::Zero();
+    slip.head(r.nf) = p.acc.segment(r.first_force, r.nf);
+    const bool slides = slip.norm() > o.speed_tol;
+    if (slides) {
+      r.dir = slip / slip.norm();
+      r.dir_start = r.dir;
+    }
+    cdata_->setSliding(r.c, slides);
+    const bool was = u.was_sliding[k] != 0;
+    if (slides && !was) logEvent(ContactEventKind::Slip, k, 0, slip.norm(), 0);
+    if (!slides && was) logEvent(ContactEventKind::Stick, k, 0, 0, 0);
+  }
+  restore(true);
+  forwardKinematics(model_, *data_, q_, v_);
+  return true;
+}
+
+}  // namespace appell
