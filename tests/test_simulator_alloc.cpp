@@ -14,7 +14,9 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <limits>
 #include <new>
+#include <string>
 
 namespace {
 std::atomic<bool> g_armed{false};
@@ -226,11 +228,14 @@ std::unique_ptr<ConstrainedSolver> solverNumber(int which, const Model& model,
 // changing, bounces) allocate nothing either: every row has its storage from
 // the start and the event list is reserved. A ball with restitution 0.5
 // dropped 0.2 m: 9 bounces and a plastic touchdown in 1.5 s, each solver,
-// dopri5 (dense-output location) and RK4 (shortened steps).
+// dopri5 (dense-output location) and RK4 (shortened steps). With μ = 0.005
+// its later impacts slide (friction_impact.cpp): none of that allocates.
 TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
+ for (double mu : {std::numeric_limits<double>::infinity(), 0.005}) {
   const double r = kBallRadius;
   ContactSpec spec;
   spec.restitution = 0.5;
+  spec.mu = mu;
   const BallOnPlane s = ballOnPlane(spec);
   const Model& model = s.model;
   const ConstraintList& c = s.constraints;
@@ -247,7 +252,7 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
       so.contacts.rest_speed = 0.01;
       Simulator sim(model, c, std::move(solver), it, {}, so);
       ASSERT_TRUE(sim.setState(0, q, v));
-      long allocations = 0, events = 0;
+      long allocations = 0, events = 0, slips = 0;
       while (sim.time() < 1.5) {
         StepStatus st;
         {
@@ -257,12 +262,18 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
         }
         ASSERT_TRUE(st.ok) << st.message;
         events += st.events;
+        for (const ContactEvent& e : sim.events()) slips += e.kind == ContactEventKind::Slip;
       }
-      EXPECT_GE(events, 8) << "solver " << which << ", " << toString(it);
-      EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
+      const std::string what = "solver " + std::to_string(which) + ", " + toString(it) + ", μ = " + std::to_string(mu);
+      EXPECT_GE(events, 8) << what;
+      if (std::isfinite(mu)) {
+        EXPECT_GE(slips, 1) << what << ": a sliding impact";
+      }
+      EXPECT_EQ(allocations, 0) << what;
       EXPECT_TRUE(sim.isClosed(0));
     }
   }
+ }
 }
 
 // Friction events allocate nothing: a ball launched sliding sticks (the
