@@ -11,6 +11,8 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -293,4 +295,94 @@ TEST(ContactFriction, BallThrownOntoThePlaneSlidesThroughTheImpact) {
           << what;
     }
   }
+}
+
+namespace {
+
+/// The ball of ballWithFriction rolling without spin, with spin friction ℓ.
+BuiltScene ballWithSpinFriction(double mu, double ell, const Vec3& vG, const Vec3& omega) {
+  BuiltScene s = ballWithFriction(mu, vG, omega, Vec3(0, 0, -kG));
+  ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+  spec.kind = ContactKind::RollingWithoutSpin;
+  spec.mu_spin = ell;
+  s.constraints[0] = makeContact(spec);
+  return s;
+}
+
+}  // namespace
+
+// Protects spin (torsional) friction (the friction issue's first item): a
+// ball rolling without spin, μ = 0.5, spin friction ℓ = 0.01 m, started
+// spinning at ω₀ = 10 rad/s about the vertical. The spin row slides with
+// the torque ℓ m g, so ω = ω₀ − (ℓ m g / I) t to round-off; it sticks at
+// t* = ω₀ I / (ℓ m g) and stays; friction took ½ I ω₀². A torque k t about
+// the vertical on the ball at rest is held until it reaches ℓ m g (the slip
+// event there), then spins it up at (k t − ℓ m g)/I. Sliding and spinning at
+// once, force and torque share the ellipsoid |(fₜ, τ μ/ℓ)| ≤ μλₙ along the
+// slip (v, ω ℓ/μ) — Leine & Glocker's elliptic approximation of the
+// Contensou coupling: at v = 1 m/s and ω ℓ/μ = 1 m/s each takes 1/√2 of
+// its limit. Three formulations.
+TEST(ContactFriction, SpinFrictionStopsASpinningBallAtTheTorsionalRate) {
+  const double mu = 0.5, ell = 0.01, w0 = 10, I = 0.4 * kM * kR * kR;
+  const double rate = ell * kM * kG / I, t_star = w0 / rate;
+  for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+    const std::string what = toString(f);
+    {
+      BuiltScene s = ballWithSpinFriction(mu, ell, Vec3::Zero(), Vec3(0, 0, w0));
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                    IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+      ASSERT_TRUE(sim.constraintData().isSliding(0)) << what;
+      const double E0 = sim.energy();
+      auto events = appell::test::advanceCollecting(sim, 0.5 * t_star);
+      EXPECT_TRUE(events.empty()) << what;
+      EXPECT_NEAR(angularVelocity(sim).z(), w0 - rate * sim.time(), 1e-9) << what;
+      EXPECT_NEAR(sim.lambda()[3], -ell * kM * kG, 1e-9) << what << ": the spin row's torque";
+      EXPECT_LT(centreVelocity(sim).norm(), 1e-12) << what;
+      events = appell::test::advanceCollecting(sim, 1.5 * t_star);
+      ASSERT_EQ(events.size(), 1u) << what;
+      EXPECT_EQ(events[0].kind, ContactEventKind::Stick) << what;
+      EXPECT_NEAR(events[0].t, t_star, 1e-9) << what;
+      EXPECT_LT(std::abs(angularVelocity(sim).z()), 1e-12) << what;
+      EXPECT_NEAR(sim.frictionWork(), 0.5 * I * w0 * w0, 1e-9) << what;
+      EXPECT_LT(std::abs(sim.energy() + sim.frictionWork() - E0), 1e-10) << what;
+    }
+    {
+      const double k = 2.0, t_slip = ell * kM * kG / k;
+      BuiltScene s = ballWithSpinFriction(mu, ell, Vec3::Zero(), Vec3::Zero());
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                    IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+      sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
+        tau.head<3>() = floatingRotation(q, 0).transpose() * Vec3(0, 0, k * t);
+      });
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+      auto events = appell::test::advanceCollecting(sim, 2 * t_slip);
+      ASSERT_EQ(events.size(), 1u) << what;
+      EXPECT_EQ(events[0].kind, ContactEventKind::Slip) << what;
+      EXPECT_NEAR(events[0].t, t_slip, 1e-9) << what;
+      const double t = sim.time();
+      EXPECT_NEAR(angularVelocity(sim).z(), (0.5 * k * (t * t - t_slip * t_slip) - ell * kM * kG * (t - t_slip)) / I,
+                  1e-8) << what;
+    }
+    {
+      BuiltScene s = ballWithSpinFriction(mu, ell, Vec3(1, 0, 0), Vec3(0, 0, mu / ell));
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints),
+                    IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+      ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+      const Vec3 ft = sim.lambda()[0] * sim.contactFrame(0).t1 + sim.lambda()[1] * sim.contactFrame(0).t2;
+      EXPECT_NEAR(ft.x(), -mu * kM * kG / std::sqrt(2.0), 1e-9) << what;
+      EXPECT_NEAR(ft.y(), 0, 1e-12) << what;
+      EXPECT_NEAR(sim.lambda()[3], -ell * kM * kG / std::sqrt(2.0), 1e-9) << what;
+    }
+  }
+  // Spin friction needs a spin row and a finite μ > 0.
+  ContactSpec spec = static_cast<const ShapeContact&>(*ballWithSpinFriction(mu, ell, Vec3::Zero(), Vec3::Zero()).constraints[0]).spec();
+  spec.kind = ContactKind::Rolling;
+  EXPECT_THROW(makeContact(spec), std::invalid_argument);
+  spec.kind = ContactKind::RollingWithoutSpin;
+  spec.mu = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(makeContact(spec), std::invalid_argument);
+  spec.mu = 0.5;
+  spec.mu_spin = -1;
+  EXPECT_THROW(makeContact(spec), std::invalid_argument);
 }

@@ -7,6 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <regex>
+#include <string>
+#include <utility>
+#include <vector>
+
 using namespace appell;
 
 namespace {
@@ -238,11 +244,28 @@ TEST(IoScene, StaticAndKineticFrictionCoefficients) {
   EXPECT_DOUBLE_EQ(s.contacts[0]->kineticFriction(), 0.4);
   const Scene one = loadSceneFromString(scene(R"(mu="0.5")"), kData, "one");
   EXPECT_DOUBLE_EQ(one.contacts[0]->kineticFriction(), 0.5) << "one coefficient for both";
+  EXPECT_TRUE(std::isnan(one.contacts[0]->spinFriction())) << "no spin friction unless declared";
+  // Spin friction: a length, on a contact with a spin row and a finite μ.
+  auto spinning = [&](const std::string& attrs) {
+    return std::regex_replace(scene(attrs), std::regex(R"(kind="rolling")"), R"(kind="rolling_without_spin")");
+  };
+  const Scene spin = loadSceneFromString(spinning(R"(mu="0.5" mu_spin="0.01")"), kData, "spin");
+  EXPECT_DOUBLE_EQ(spin.contacts[0]->spinFriction(), 0.01);
+  for (const std::string& attrs : {std::string(R"(mu_spin="0.01")"), std::string(R"(mu="0" mu_spin="0.01")")}) {
+    try {
+      loadSceneFromString(spinning(attrs), kData, "bad");
+      ADD_FAILURE() << attrs << " accepted";
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("'mu_spin' needs a finite 'mu' > 0"), std::string::npos) << e.what();
+    }
+  }
   for (const auto& [attrs, why] : std::vector<std::pair<std::string, std::string>>{
            {R"(mu="0.5" mu_static="0.6" mu_kinetic="0.4")", "give either 'mu' or 'mu_static'"},
            {R"(mu_kinetic="0.4")", "'mu_static' and 'mu_kinetic' go together"},
            {R"(mu_static="0.3" mu_kinetic="0.4")", "'mu_kinetic' must not exceed 'mu_static'"},
-           {R"(mu_static="0.3" mu_kinetic="-1")", "must not be negative"}}) {
+           {R"(mu_static="0.3" mu_kinetic="-1")", "must not be negative"},
+           {R"(mu="0.5" mu_spin="-0.01")", "'mu_spin' must be a positive length"},
+           {R"(mu="0.5" mu_spin="0.01")", "'mu_spin' needs kind=\"rolling_without_spin\""}}) {
     try {
       loadSceneFromString(scene(attrs), kData, "bad");
       ADD_FAILURE() << attrs << " accepted";

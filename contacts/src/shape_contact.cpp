@@ -82,6 +82,15 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
   if (!(spec_.restitution >= 0 && spec_.restitution <= 1))
     fail("the restitution must lie in [0, 1] (0: plastic, 1: elastic), got " +
          std::to_string(spec_.restitution));
+  if (!std::isnan(spec_.mu_spin)) {
+    if (!(spec_.mu_spin > 0 && std::isfinite(spec_.mu_spin)))
+      fail("the spin friction length must be positive and finite (m), got " +
+           std::to_string(spec_.mu_spin));
+    if (spec_.kind != ContactKind::RollingWithoutSpin)
+      fail("spin friction needs a contact with a spin row (kind rolling_without_spin)");
+    if (!(spec_.mu > 0 && std::isfinite(spec_.mu)))
+      fail("spin friction needs a finite friction coefficient μ > 0 (the cone it shares)");
+  }
   try {
     validateShape(shape);
     validateSupport(support);

@@ -27,6 +27,10 @@ std::vector<ContactStats> contactStats(const Scene& scene) {
       const RowKind kind = c.rowKind(r);
       if (kind == RowKind::Normal) e.normal_row = offset + r;
       if (isTangential(kind)) e.tangential_rows.push_back(offset + r);
+      if (kind == RowKind::Spin && std::isfinite(c.spinFriction()) && c.friction() > 0) {
+        e.spin_row = offset + r;
+        e.spin_scale = c.spinFriction() / c.friction();
+      }
     }
     if (e.normal_row < 0 && c.rows() == 1) e.reaction_row = offset;
     offset += c.rows();
@@ -86,6 +90,7 @@ void sample(std::vector<ContactStats>& stats, double t, const VecX& lambda,
     const double fn = lambda[e.normal_row];
     double ft2 = 0;
     for (int r : e.tangential_rows) ft2 += lambda[r] * lambda[r];
+    if (e.spin_row >= 0) ft2 += std::pow(lambda[e.spin_row] / e.spin_scale, 2);
     const double ft = std::sqrt(ft2);
     e.min_normal = std::min(e.min_normal, fn);
     e.max_normal = std::max(e.max_normal, fn);

@@ -67,6 +67,12 @@ struct ContactSpec {
   /// (≤ mu, which is then the static one: the cone that sticking must stay
   /// in). NaN: the same as mu.
   double mu_kinetic = std::numeric_limits<double>::quiet_NaN();
+  /// Torsional friction of a rolling-without-spin contact, a length ℓ > 0
+  /// (m): the spin torque a sticking contact holds alone is ℓ λₙ, and with
+  /// the tangential force the pair stays in the ellipsoid |(fₜ, τₙ μ/ℓ)| ≤ μλₙ
+  /// (docs/contacts.md §8). NaN: none (the spin row is ideal while the
+  /// contact sticks and free while it slides). Needs a finite μ > 0.
+  double mu_spin = std::numeric_limits<double>::quiet_NaN();
   /// The contact can open: it lifts off when its normal force would pull and
   /// closes when its gap reaches zero (contact_events.hpp). false: a
   /// bilateral idealisation (a wheel on a rail that holds it down).
@@ -101,6 +107,7 @@ class ShapeContact : public Constraint {
   double kineticFriction() const override {
     return std::isnan(spec_.mu_kinetic) ? spec_.mu : spec_.mu_kinetic;
   }
+  double spinFriction() const override { return spec_.mu_spin; }
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;

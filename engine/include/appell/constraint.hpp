@@ -118,6 +118,12 @@ class Constraint {
   /// force is μₖ λₙ; friction() is then the static one, the cone sticking
   /// stays in and a stopped slip must fit to stick again. Default: the same.
   virtual double kineticFriction() const { return friction(); }
+  /// Torsional (spin) friction, a length ℓ: a sticking contact's spin row
+  /// holds while its friction (λₜ, τₙ/(ℓ/μ)) stays in the cone μ λₙ — the
+  /// torque alone up to ℓ λₙ — and a sliding one takes the maximally
+  /// dissipating force and torque of that ellipsoid (docs/contacts.md §8).
+  /// NaN: none (the spin row is ideal while sticking, free while sliding).
+  virtual double spinFriction() const { return std::numeric_limits<double>::quiet_NaN(); }
   /// Constant-size storage the block needs (called once, outside the step).
   virtual void reserve(const Model& model, RowBlock& block) const;
   /// Writes the rows at (q, v, t). `data` holds forwardKinematics(q, v).

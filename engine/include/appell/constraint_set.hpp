@@ -61,6 +61,10 @@ struct ConstraintData {
   struct SlidingRows {
     int n = 0;                               ///< friction rows (tangent1/2, lateral)
     int row[3] = {-1, -1, -1};               ///< their indices in the constraint
+    /// Row i's unit in the friction law: 1, or ℓ/μ for a spin row (its
+    /// covectors, slip and κ below are scaled by it, its multiplier — the
+    /// torque — divided by it: Constraint::spinFriction()).
+    double scale[3] = {1, 1, 1};
     Eigen::Matrix<double, 3, 6> Wa = Eigen::Matrix<double, 3, 6>::Zero();  ///< covectors on body A
     Eigen::Matrix<double, 3, 6> Wb = Eigen::Matrix<double, 3, 6>::Zero();  ///< and on body B
     Vec3 slip = Vec3::Zero();                ///< row values: the slip velocity along each

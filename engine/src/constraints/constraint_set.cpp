@@ -28,6 +28,16 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
     if (c.jointSpace() || !c.unilateral()) continue;
     for (int r = 0; r < c.rows() && slide[k].n < 3; ++r)
       if (isTangential(c.rowKind(r))) slide[k].row[slide[k].n++] = r;
+    // Spin friction: the spin row joins the friction rows, in the unit that
+    // makes the friction set the ball of radius μλₙ (Leine & Glocker 2003).
+    const double ell = c.spinFriction(), mu = c.friction();
+    if (std::isfinite(ell) && std::isfinite(mu) && mu > 0 && slide[k].n < 3)
+      for (int r = 0; r < c.rows(); ++r)
+        if (c.rowKind(r) == RowKind::Spin) {
+          slide[k].scale[slide[k].n] = ell / mu;
+          slide[k].row[slide[k].n++] = r;
+          break;
+        }
   }
   m_active = m;
   b = VecX::Zero(m);
@@ -108,11 +118,12 @@ void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList
       const Vec6 Vb = bb >= 0 ? Vec6(data.oMi[bb].act(data.v[bb])) : Vec6::Zero();
       for (int i = 0; i < sr.n; ++i) {
         const int r = sr.row[i];
-        sr.Wa.row(i) = blk.Wa.row(r);
-        sr.Wb.row(i) = blk.Wb.row(r);
-        sr.kappa[i] = blk.kappa[r];
-        sr.slip[i] = blk.b[r] + (a >= 0 ? blk.Wa.row(r).dot(Va) : 0.0) -
-                     (bb >= 0 ? blk.Wb.row(r).dot(Vb) : 0.0);
+        const double s = sr.scale[i];
+        sr.Wa.row(i) = s * blk.Wa.row(r);
+        sr.Wb.row(i) = s * blk.Wb.row(r);
+        sr.kappa[i] = s * blk.kappa[r];
+        sr.slip[i] = s * (blk.b[r] + (a >= 0 ? blk.Wa.row(r).dot(Va) : 0.0) -
+                          (bb >= 0 ? blk.Wb.row(r).dot(Vb) : 0.0));
       }
       const int keep = c.unilateralRow();
       for (int r = 0; r < m; ++r) {

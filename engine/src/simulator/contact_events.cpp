@@ -144,7 +144,7 @@ Vec3 Simulator::frictionForce(int k, const VecX& lambda) const {
   const UnilateralRow& r = uni_->rows[k];
   const auto& sr = cdata_->slide[r.c];
   Vec3 f = Vec3::Zero();
-  for (int i = 0; i < sr.n; ++i) f[i] = lambda[cdata_->offset[r.c] + sr.row[i]];
+  for (int i = 0; i < sr.n; ++i) f[i] = lambda[cdata_->offset[r.c] + sr.row[i]] / sr.scale[i];
   return f;
 }
 

@@ -137,7 +137,7 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
       const UnilateralRow& r = u->rows[u->sliding[j]];
       const auto& sr = cdata_->slide[r.c];
       for (int i = 0; i < sr.n; ++i)
-        out.lambda[cdata_->offset[r.c] + sr.row[i]] = -r.mu_k * u->s[j] * r.dir[i];
+        out.lambda[cdata_->offset[r.c] + sr.row[i]] = -r.mu_k * u->s[j] * r.dir[i] * sr.scale[i];
     }
   }
   return true;

@@ -53,7 +53,8 @@ bool Simulator::frictionImpact(std::string& error) {
     if (!r.touching || !r.in_set || r.nf == 0) continue;
     const auto& sr = cdata_->slide[r.c];
     double pt = 0;
-    for (int i = 0; i < sr.n; ++i) pt += std::pow(u.impulse[cdata_->offset[r.c] + sr.row[i]], 2);
+    for (int i = 0; i < sr.n; ++i)
+      pt += std::pow(u.impulse[cdata_->offset[r.c] + sr.row[i]] / sr.scale[i], 2);
     needed = needed || cdata_->isSliding(r.c) ||
              std::sqrt(pt) > r.mu * std::max(0.0, r.impulse) * (1 + 1e-9);
     r.first_force = F;
@@ -157,7 +158,8 @@ bool Simulator::frictionImpact(std::string& error) {
     }
     r.impulse = pn;
     u.impulse[r.global] = -pn;
-    for (int i = 0; i < sr.n; ++i) u.impulse[cdata_->offset[r.c] + sr.row[i]] = -p.f[r.first_force + i];
+    for (int i = 0; i < sr.n; ++i)
+      u.impulse[cdata_->offset[r.c] + sr.row[i]] = -p.f[r.first_force + i] * sr.scale[i];
     Vec3 slip = Vec3::Zero();
     slip.head(r.nf) = p.acc.segment(r.first_force, r.nf);
     const bool slides = slip.norm() > o.speed_tol;

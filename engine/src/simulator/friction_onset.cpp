@@ -168,7 +168,7 @@ Vec3 Simulator::contactSlip(int k) const {
     double val = blk.b[row];
     if (r.a >= 0) val += blk.Wa.row(row).dot(data_->oMi[r.a].act(data_->v[r.a]));
     if (r.b >= 0) val -= blk.Wb.row(row).dot(data_->oMi[r.b].act(data_->v[r.b]));
-    slip[i] = val;
+    slip[i] = sr.scale[i] * val;
   }
   return slip;
 }

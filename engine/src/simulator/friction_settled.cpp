@@ -246,7 +246,8 @@ bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX
       r.dir.head(r.nf) = -p.f.segment(r.settle_force, r.nf) / fn;
     }
     if (outputs == SolveOutputs::All)
-      for (int i = 0; i < sr.n; ++i) out.lambda[cdata_->offset[r.c] + sr.row[i]] = p.f[r.settle_force + i];
+      for (int i = 0; i < sr.n; ++i)
+        out.lambda[cdata_->offset[r.c] + sr.row[i]] = p.f[r.settle_force + i] * sr.scale[i];
   }
   restore();
   return true;

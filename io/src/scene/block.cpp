@@ -135,7 +135,7 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
   if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
   static const char* const kCommon[] = {"name",      "link",        "kind",      "support",
                                         "mu",        "direction",   "restitution", "unilateral",
-                                        "mu_static", "mu_kinetic"};
+                                        "mu_static", "mu_kinetic", "mu_spin"};
   auto allow = [&](const std::vector<const char*>& extra) {
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string n = a->Name();
@@ -218,6 +218,15 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
     if (!(d.spec.mu_kinetic <= d.spec.mu))
       fail(src, e, "'mu_kinetic' must not exceed 'mu_static' (a contact that starts to slide "
                    "would hold harder than sticking could)");
+  }
+  if (has(e, "mu_spin")) {
+    d.spec.mu_spin = number(src, e, "mu_spin");
+    if (!(d.spec.mu_spin > 0))
+      fail(src, e, "spin friction 'mu_spin' must be a positive length (m): the torque it holds per newton of load");
+    if (d.spec.kind != ContactKind::RollingWithoutSpin)
+      fail(src, e, "'mu_spin' needs kind=\"rolling_without_spin\" (a contact with a spin row)");
+    if (!(d.spec.mu > 0 && std::isfinite(d.spec.mu)))
+      fail(src, e, "'mu_spin' needs a finite 'mu' > 0 (the friction cone it shares)");
   }
   if (has(e, "restitution")) {
     d.spec.restitution = number(src, e, "restitution");

@@ -100,7 +100,8 @@ InitialStateReport checkInitialState(Scene& scene, bool project, double tol) {
       if (!con.unilateral() || !cd.isActive(c) || sr.n == 0 || !std::isfinite(con.friction()))
         continue;
       double slip2 = 0;
-      for (int i = 0; i < sr.n; ++i) slip2 += std::pow(residual[cd.offset[c] + sr.row[i]], 2);
+      for (int i = 0; i < sr.n; ++i)
+        slip2 += std::pow(sr.scale[i] * residual[cd.offset[c] + sr.row[i]], 2);
       if (std::sqrt(slip2) > floor) {
         cd.setSliding(c, true);
         report.sliding.push_back(con.name());

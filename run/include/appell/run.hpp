@@ -89,6 +89,10 @@ struct ContactStats {
   double mu = std::numeric_limits<double>::infinity();  ///< the scene's μ (∞: unchecked)
   int normal_row = -1;             ///< λ index of the normal row, −1: none (no stats)
   std::vector<int> tangential_rows;  ///< λ indices of tangent and lateral rows
+  /// With spin friction ℓ: the spin row's λ index and its unit ℓ/μ (its
+  /// torque over ℓ/μ joins the friction demand); −1 without.
+  int spin_row = -1;
+  double spin_scale = 1;
   double min_normal = std::numeric_limits<double>::infinity(), max_normal = 0;
   double max_demand = 0, t_max_demand = 0;  ///< max |f_t| / f_n and when
   long pulling = 0, over_mu = 0;   ///< samples with f_n ≤ 0, with |f_t| / f_n > μ
