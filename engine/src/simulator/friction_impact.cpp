@@ -105,31 +105,20 @@ bool Simulator::frictionImpact(std::string& error) {
     const UnilateralRow& r = u.rows[u.onset[j]];
     p.a0.segment(r.first_force, r.nf) = cdata_->slide[r.c].slip.head(r.nf);
   }
-  // Block Gauss–Seidel over the disks, the normal impulses updated.
-  p.f.head(F).setZero();
-  bool settled = false;
-  for (int sweep = 0; sweep < 10000 && !settled; ++sweep) {
-    p.f_old.head(F) = p.f.head(F);
-    double fmax = 0;
-    for (int j = 0; j < K; ++j) {
-      const UnilateralRow& r = u.rows[u.onset[j]];
-      const int o0 = r.first_force, n = r.nf;
-      const double pn = std::max(0.0, p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F)));
-      Mat3 H = Mat3::Zero();
-      H.topLeftCorner(n, n) = p.W.block(o0, o0, n, n);
-      H = 0.5 * (H + H.transpose()).eval();
-      Vec3 c = Vec3::Zero();
-      c.head(n) = p.a0.segment(o0, n);
-      c.head(n).noalias() += p.W.block(o0, 0, n, F) * p.f.head(F);
-      c.head(n).noalias() -= H.topLeftCorner(n, n) * p.f.segment(o0, n);
-      Vec3 fj = detail::diskMinimizer(H, c, n, r.mu * pn);
-      if (fj.norm() >= (1 - 1e-12) * r.mu * pn) fj = detail::diskMinimizer(H, c, n, r.mu_k * pn);
-      p.f.segment(o0, n) = fj.head(n);
-      fmax = std::max(fmax, r.mu * pn);
-    }
-    settled = sweep > 0 && (p.f.head(F) - p.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
-                               1e-14 * std::max(fmax, 1e-300);
-  }
+  // Block Gauss–Seidel over the disks, the normal impulses updated: a
+  // contact sticks inside its static disk, else slides on its kinetic one.
+  const bool settled = p.gaussSeidel(K, F, 10000, [&](int j) {
+    const UnilateralRow& r = u.rows[u.onset[j]];
+    const int o0 = r.first_force, n = r.nf;
+    const double pn = std::max(0.0, p.loadAt(j, F));
+    Mat3 H;
+    Vec3 c;
+    p.disk(o0, n, F, H, c);
+    Vec3 fj = detail::diskMinimizer(H, c, n, r.mu * pn);
+    if (fj.norm() >= (1 - 1e-12) * r.mu * pn) fj = detail::diskMinimizer(H, c, n, r.mu_k * pn);
+    p.f.segment(o0, n) = fj.head(n);
+    return r.mu * pn;
+  });
   if (!settled) {
     // Keep the sticking impact (its cone excess is then reported).
     ++counters_.friction_onset_unsettled;
@@ -147,7 +136,7 @@ bool Simulator::frictionImpact(std::string& error) {
     const int k = u.onset[j];
     UnilateralRow& r = u.rows[k];
     const auto& sr = cdata_->slide[r.c];
-    const double pn = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
+    const double pn = p.loadAt(j, F);
     if (pn < -o.force_tol) {
       restore(false);
       v_ = u.vstick;

@@ -219,36 +219,23 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
     return false;
   }
   // Block Gauss–Seidel, the loads updated as it goes.
-  p.f.head(F).setZero();
-  bool settled = false;
-  for (int sweep = 0; sweep < 10000 && !settled; ++sweep) {
-    p.f_old.head(F) = p.f.head(F);
-    double fmax = 0;
-    for (int j = 0; j < K; ++j) {
-      const UnilateralRow& r = u.rows[u.onset[j]];
-      const int o0 = r.first_force, n = r.nf;
-      const double load = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
-      const double radius = r.mu * std::max(0.0, load);
-      Mat3 H = Mat3::Zero();
-      H.topLeftCorner(n, n) = p.W.block(o0, o0, n, n);
-      H = 0.5 * (H + H.transpose()).eval();
-      Vec3 c = Vec3::Zero();
-      c.head(n) = p.a0.segment(o0, n);  // (products one by one: no temporaries)
-      c.head(n).noalias() += p.W.block(o0, 0, n, F) * p.f.head(F);
-      c.head(n).noalias() -= H.topLeftCorner(n, n) * p.f.segment(o0, n);
-      Vec3 fj = detail::diskMinimizer(H, c, n, radius);
-      if (u.onset[j] == forced && fj.norm() < radius) {
-        // At its slip event: on the cone, along the sticking force found
-        // (or the one it had).
-        const Vec3 d = fj.norm() > 0 ? Vec3(fj / fj.norm()) : Vec3(-r.dir);
-        fj = radius * d;
-      }
-      p.f.segment(o0, n) = fj.head(n);
-      fmax = std::max(fmax, radius);
+  const bool settled = p.gaussSeidel(K, F, 10000, [&](int j) {
+    const UnilateralRow& r = u.rows[u.onset[j]];
+    const int o0 = r.first_force, n = r.nf;
+    const double radius = r.mu * std::max(0.0, p.loadAt(j, F));
+    Mat3 H;
+    Vec3 c;
+    p.disk(o0, n, F, H, c);
+    Vec3 fj = detail::diskMinimizer(H, c, n, radius);
+    if (u.onset[j] == forced && fj.norm() < radius) {
+      // At its slip event: on the cone, along the sticking force found
+      // (or the one it had).
+      const Vec3 d = fj.norm() > 0 ? Vec3(fj / fj.norm()) : Vec3(-r.dir);
+      fj = radius * d;
     }
-    settled = sweep > 0 && (p.f.head(F) - p.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
-                               1e-14 * std::max(fmax, 1e-300);
-  }
+    p.f.segment(o0, n) = fj.head(n);
+    return radius;
+  });
   restore();
   if (!settled) {
     ++counters_.friction_onset_unsettled;
@@ -266,7 +253,7 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
     Vec3 fj = Vec3::Zero(), aj = Vec3::Zero();
     fj.head(n) = p.f.segment(r.first_force, n);
     aj.head(n) = p.acc.segment(r.first_force, n);
-    const double load = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
+    const double load = p.loadAt(j, F);
     const bool on_cone = fj.norm() >= (1 - 1e-9) * r.mu * std::max(0.0, load);
     const bool slides = k == forced || (on_cone && aj.norm() > atol);
     const bool was = u.was_sliding[k] != 0;

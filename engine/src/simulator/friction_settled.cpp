@@ -184,40 +184,27 @@ bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX
   // circle, slides along its slip (its force then known, still affine in
   // its load).
   const double floor = 10 * options_.contacts.speed_tol;
-  p.f.head(F).setZero();
-  bool settled = false;
-  for (int sweep = 0; sweep < 1000 && !settled; ++sweep) {
-    p.f_old.head(F) = p.f.head(F);
-    double fmax = 0;
-    for (int j = 0; j < K; ++j) {
-      UnilateralRow& r = u.rows[u.settle[j]];
-      const int o0 = r.settle_force, n = r.nf;
-      const double load = p.ln0[j] + p.N.row(j).head(F).dot(p.f.head(F));
-      const double radius = r.mu_k * std::max(0.0, load);
-      const double slip = cdata_->slide[r.c].slip.norm();
-      Vec3 fj = Vec3::Zero();
-      if (slip < settle_time * radius * u.swmax[j]) {
-        Mat3 H = Mat3::Zero();
-        H.topLeftCorner(n, n) = p.W.block(o0, o0, n, n);
-        H = 0.5 * (H + H.transpose()).eval();
-        Vec3 c = Vec3::Zero();
-        c.head(n) = p.a0.segment(o0, n);
-        c.head(n).noalias() += p.W.block(o0, 0, n, F) * p.f.head(F);
-        c.head(n).noalias() -= H.topLeftCorner(n, n) * p.f.segment(o0, n);
-        // The stable settled direction on the slip's own side.
-        detail::slipDirection(*cdata_, r, floor);
-        if (!settledForce(H, c, n, radius, r.dir, fj)) fj.setZero();  // along its slip (below)
-      }
-      if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
-        detail::slipDirection(*cdata_, r, floor);
-        fj = -radius * r.dir;
-      }
-      p.f.segment(o0, n) = fj.head(n);
-      fmax = std::max(fmax, radius);
+  const bool settled = p.gaussSeidel(K, F, 1000, [&](int j) {
+    UnilateralRow& r = u.rows[u.settle[j]];
+    const int o0 = r.settle_force, n = r.nf;
+    const double radius = r.mu_k * std::max(0.0, p.loadAt(j, F));
+    const double slip = cdata_->slide[r.c].slip.norm();
+    Vec3 fj = Vec3::Zero();
+    if (slip < settle_time * radius * u.swmax[j]) {
+      Mat3 H;
+      Vec3 c;
+      p.disk(o0, n, F, H, c);
+      // The stable settled direction on the slip's own side.
+      detail::slipDirection(*cdata_, r, floor);
+      if (!settledForce(H, c, n, radius, r.dir, fj)) fj.setZero();  // along its slip (below)
     }
-    settled = sweep > 0 && (p.f.head(F) - p.f_old.head(F)).lpNorm<Eigen::Infinity>() <=
-                               1e-14 * std::max(fmax, 1e-300);
-  }
+    if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
+      detail::slipDirection(*cdata_, r, floor);
+      fj = -radius * r.dir;
+    }
+    p.f.segment(o0, n) = fj.head(n);
+    return radius;
+  });
   if (!settled) {
     // Along their slips, as without this path (the loads still exact).
     ++counters_.settle_unsettled;

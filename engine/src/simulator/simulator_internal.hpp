@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -71,6 +72,37 @@ struct FrictionProblem {
   MatX V;  // with_velocities: the generalized velocities' (v̇'s) response (nv × F)
   VecX a0, ln0, acc, load, f, f_old, tau;
   ConstrainedResult res;
+  /// Block Gauss–Seidel's view of the contact whose n rows start at o0
+  /// (the others' forces fixed): min ½ f_jᵀH f_j + cᵀf_j, H its W block
+  /// (symmetrized), c = a0_j + Σ_{i≠j} W_ji f_i.
+  void disk(int o0, int n, int F, Mat3& H, Vec3& c) const {
+    H.setZero();
+    H.topLeftCorner(n, n) = W.block(o0, o0, n, n);
+    H = 0.5 * (H + H.transpose()).eval();
+    c.setZero();
+    c.head(n) = a0.segment(o0, n);  // (products one by one: no temporaries)
+    c.head(n).noalias() += W.block(o0, 0, n, F) * f.head(F);
+    c.head(n).noalias() -= H.topLeftCorner(n, n) * f.segment(o0, n);
+  }
+  /// Block Gauss–Seidel from f = 0 over K contacts until f stops changing
+  /// (to 1e-14 of the largest radius): block(j) sets contact j's forces in
+  /// f (the loads read the others' as they are) and returns its disk's
+  /// radius. false when `sweeps` sweeps did not settle it.
+  template <class Block>
+  bool gaussSeidel(int K, int F, int sweeps, Block&& block) {
+    f.head(F).setZero();
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+      f_old.head(F) = f.head(F);
+      double fmax = 0;
+      for (int j = 0; j < K; ++j) fmax = std::max(fmax, block(j));
+      if (sweep > 0 && (f.head(F) - f_old.head(F)).lpNorm<Eigen::Infinity>() <=
+                           1e-14 * std::max(fmax, 1e-300))
+        return true;
+    }
+    return false;
+  }
+  /// Contact j's load (normal force or impulse) at the current forces.
+  double loadAt(int j, int F) const { return ln0[j] + N.row(j).head(F).dot(f.head(F)); }
   void size(int nv, int nf, int kf, const ConstrainedResult& like) {
     U = MatX::Zero(nv, nf);
     V = MatX::Zero(nv, nf);
