@@ -61,12 +61,15 @@ namespace {
 /// shrinking, when the minimizer is inside the circle) and at most at two in
 /// (−λ₂, −λ₁), convex there: the one nearest −λ₁ is stable, on the other
 /// side of e₁ (the slip shrinking along itself). Taken: the upper root with
-/// κ ≥ 0 on side's half; a shrinking root (κ < 0) within kSettledAlong of
-/// `side`. false otherwise: the slip's direction is not settled, and it
-/// slides along it.
-/// cos of the largest angle between a shrinking slip and its settled
-/// direction for that direction to be taken (settledForce).
-constexpr double kSettledAlong = 0.99;
+/// κ ≥ 0 on side's half; a shrinking root (κ < 0) on side's half when the
+/// slip along `side` shrinks, under the exact law, at most kSettledShrink
+/// times as fast as its direction relaxes onto the root — rates
+/// −ŝᵀ(c − rHŝ)/|s| and r(λ₂ + κ)/|s| (the smallest eigenvalue of H + κI
+/// across the root). false otherwise: the slip's direction is not settled,
+/// and it slides along it.
+/// The largest ratio of a slip's shrinking rate to its direction's
+/// relaxation rate for a shrinking settled direction to be taken.
+constexpr double kSettledShrink = 0.1;
 
 bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& side, Vec3& f) {
   Mat3 Hp = Mat3::Zero();
@@ -106,11 +109,17 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
   }
   // A growing slip (κ ≥ 0) keeps its direction while it relaxes onto this
   // one; a shrinking one may stop first — a slip that its own friction
-  // brakes, as much as it turns it, ends in a stick event, and its direction
-  // on the way is the exact law's — so it takes a shrinking branch only when
-  // it already points along it (within kSettledAlong).
+  // brakes about as fast as it turns it ends in a stick event, and its
+  // direction on the way is the exact law's — so it takes a shrinking root
+  // only when it shrinks slowly beside that relaxation (a scrub that the
+  // geometry, not its friction, winds down).
+  const double shrink = -side.dot(c - r * (H * side));  // d|s|/dt = −shrink (exact law)
+  auto slowly = [&](double kappa) {
+    const double across = n > 1 ? lam[1] + kappa : HUGE_VAL;
+    return shrink <= kSettledShrink * r * across;
+  };
   f = force(b);
-  if (f.allFinite() && -f.dot(side) > (b >= 0 ? 0.0 : kSettledAlong * r)) return true;
+  if (f.allFinite() && -f.dot(side) > 0 && (b >= 0 || slowly(b))) return true;
   // The lower root nearest −λ₁: right of |f|²'s minimum on (−λ₂, −λ₁) (one
   // direction: on (−λ₁ − 2|c|/r, −λ₁), |f| < r at its left end).
   const double hi = -lam[0];
@@ -137,7 +146,7 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
     (norm2(mid) < r * r ? a : b) = mid;
   }
   f = force(a);
-  return f.allFinite() && -f.dot(side) > kSettledAlong * r;
+  return f.allFinite() && -f.dot(side) > 0 && slowly(a);
 }
 
 }  // namespace
