@@ -159,6 +159,7 @@ void printEvents(std::ostream& out, const RunSummary& r) {
     if (e.kind != ContactEventKind::LiftOff && e.speed_before < 0)
       out << "  normal speed " << e.speed_before << " → " << e.speed_after << " m/s, impulse "
           << e.normal_impulse << " N·s";
+    if (!e.piece.empty()) out << "  onto " << e.piece;
     if (e.outside_friction_cone)
       out << "  ⚠ tangential impulse " << e.tangential_impulse
           << " outside the friction cone: would slip";

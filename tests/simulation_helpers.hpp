@@ -44,6 +44,16 @@ struct WatchedRun {
   std::vector<ContactEvent> events;
   double worst_energy = 0;
   double at_lift_off = std::nan("");
+  std::vector<double> at_event;  ///< the value at each event's step end (as events)
+  /// The events other than changes of terrain piece, and those changes.
+  std::vector<ContactEvent> modeEvents() const { return filtered(false); }
+  std::vector<ContactEvent> featureEvents() const { return filtered(true); }
+  std::vector<ContactEvent> filtered(bool feature) const {
+    std::vector<ContactEvent> out;
+    for (const ContactEvent& e : events)
+      if ((e.kind == ContactEventKind::Feature) == feature) out.push_back(e);
+    return out;
+  }
 };
 
 /// Steps of h until t_end (every step must succeed), watching the energy
@@ -59,8 +69,9 @@ WatchedRun runWatching(Simulator& sim, double t_end, F&& at_lift_off, double h =
     if (!st.ok) break;
     for (const ContactEvent& e : sim.events()) {
       run.events.push_back(e);
+      run.at_event.push_back(at_lift_off(sim));
       if (e.kind == ContactEventKind::LiftOff && std::isnan(run.at_lift_off))
-        run.at_lift_off = at_lift_off(sim);
+        run.at_lift_off = run.at_event.back();
     }
     run.worst_energy = std::max(
         run.worst_energy,

@@ -277,7 +277,7 @@ TEST(ContactTerrain, BallRollsDownARampFaceWithTheAnalyticAcceleration) {
 // and N reaches zero at cos φ* = (7 v₀²/(g r) + 10)/17. Fast enough, it lifts
 // off there (the event located to 1e-9 in φ), flies and lands on the ramp;
 // slowly, it pivots through α and rolls on down the ramp, with energy
-// conserved and no event.
+// conserved and no mode event — only its changes of piece, located.
 TEST(ContactTerrain, BallPivotsAboutTheCreaseAndLiftsOffWhereTheoryPredicts) {
   const double r = 0.1, mass = 1.0, g = 9.81;
   const Model model = ballModel(mass, r);
@@ -292,7 +292,7 @@ TEST(ContactTerrain, BallPivotsAboutTheCreaseAndLiftsOffWhereTheoryPredicts) {
     ASSERT_TRUE(sim.setState(0, q, v)) << sim.lastStateError();
     const auto run = appell::test::runWatching(
         sim, 1.0, [](const Simulator& s) { return std::atan2(s.q()[0], s.q()[2]); });
-    const auto& events = run.events;
+    const auto events = run.modeEvents();
     const double phi_lift = run.at_lift_off;
     EXPECT_LT(run.worst_energy, 1e-8) << "E + impact losses is conserved";
     const Vec3 ramp(std::sin(kSlope), 0, std::cos(kSlope));
@@ -308,6 +308,14 @@ TEST(ContactTerrain, BallPivotsAboutTheCreaseAndLiftsOffWhereTheoryPredicts) {
       EXPECT_TRUE(events.empty()) << "a slow ball pivots through the crease in contact";
       EXPECT_GT(sim.q()[0], 0.3) << "and rolls on down the ramp";
     }
+    // Its changes of piece are located events: onto the edge when its
+    // centre passes over it (t = 0.2/v₀, φ = 0), and slowly, onto the ramp's
+    // face when it has pivoted through the slope (φ = α).
+    const auto pieces = run.featureEvents();
+    ASSERT_EQ(pieces.size(), v0 > 0.9 ? 1u : 2u);
+    EXPECT_NEAR(pieces[0].t, 0.2 / v0, 1e-11) << "onto the edge";
+    EXPECT_NEAR(run.at_event[0], 0, 1e-11);
+    if (v0 < 0.9) EXPECT_NEAR(run.at_event.back(), kSlope, 1e-8) << "onto the ramp";
   }
 }
 

@@ -63,7 +63,7 @@ TEST(ContactTerrainEdges, WheelRollsOffAPlatformAndLiftsOffWhereTheoryPredicts) 
     ASSERT_TRUE(sim.isClosed(0));
     const auto run = appell::test::runWatching(
         sim, 1.0, [](const Simulator& s) { return std::atan2(s.q()[0], s.q()[2]); });
-    const auto& events = run.events;
+    const auto events = run.modeEvents();
     const double phi_lift = run.at_lift_off;
     const double worst = run.worst_energy;
     ASSERT_GE(events.size(), 2u);
@@ -73,11 +73,18 @@ TEST(ContactTerrainEdges, WheelRollsOffAPlatformAndLiftsOffWhereTheoryPredicts) 
     EXPECT_LT(phi_star, M_PI / 3) << "before the cliff face could take over";
     EXPECT_EQ(events[1].kind, ContactEventKind::Touchdown) << "lands on the cliff face";
     // It rolls down the cliff into the concave crease at its foot, where the
-    // ground's rising face meets it: an impact (at the step's end), its loss
-    // counted in the energy balance below.
+    // ground's rising face meets it: an impact, its loss counted in the
+    // energy balance below.
     ASSERT_EQ(events.size(), 3u);
     EXPECT_EQ(events[2].kind, ContactEventKind::Touchdown);
     EXPECT_LT(events[2].speed_before, -1.0) << "hits the ground at the crease";
+    // The changes of piece are located events: onto the platform's edge
+    // where the wheel's centre passes over it (t = 0.3/v₀), and onto the
+    // ground's face at the crease, with the impact there.
+    const auto pieces = run.featureEvents();
+    ASSERT_EQ(pieces.size(), 2u);
+    EXPECT_NEAR(pieces[0].t, 0.3 / v0, 1e-10) << "onto the edge";
+    EXPECT_EQ(pieces[1].t, events[2].t) << "onto the ground's face, with the impact";
     EXPECT_NEAR(sim.q()[2], R - kDrop, 1e-8) << "rolling on the ground below";
     EXPECT_LT((sim.contactFrame(0).normal - Vec3::UnitZ()).norm(), 1e-9);
     EXPECT_LT(worst, 1e-8) << "E + impact losses is conserved";

@@ -6,6 +6,7 @@
 #include <appell/contacts.hpp>
 #include <appell/kkt.hpp>
 #include <appell/simulator.hpp>
+#include <appell/terrain.hpp>
 
 #include "scene.hpp"
 #include "test_solver_rows.hpp"
@@ -323,6 +324,46 @@ TEST(SimulatorAllocation, FrictionEventsDoNotAllocate) {
       EXPECT_EQ(sticks, 1) << "solver " << which << ", " << toString(it);
       EXPECT_GE(slips, 1) << "solver " << which << ", " << toString(it);
       EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
+    }
+  }
+}
+
+// Changes of terrain piece allocate nothing (contact_features.cpp): a ball
+// rolling at 0.5 m/s over a convex crease onto a ramp of slope 1/4 moves onto
+// the edge, pivots, and moves onto the ramp's face — two located events — in
+// each solver, with dense-output location (dopri5) and shortened steps.
+TEST(SimulatorAllocation, TerrainFeatureEventsDoNotAllocate) {
+  ContactSpec spec;
+  BallOnPlane s = ballOnPlane(spec);
+  spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+  spec.support = Support{makeTerrain({Vec3(-4, 0, 0), Vec3(0, -3, 0), Vec3(0, 3, 0), Vec3(3, 0, -0.75)},
+                                     {{0, 1, 2}, {1, 3, 2}}),
+                         StaticMotion{}, "crease", -1};
+  s.constraints = {makeContact(spec)};
+  VecX q = neutralConfiguration(s.model);
+  q.head<3>() = Vec3(-0.2, 0.1, kBallRadius);
+  VecX v = VecX::Zero(s.model.nv);
+  v[1] = 0.5 / kBallRadius;  // rolling along +x
+  v[3] = 0.5;
+  for (int which = 0; which < 3; ++which) {
+    for (IntegratorType it : {IntegratorType::Leapfrog, IntegratorType::RK4,
+                              IntegratorType::DormandPrince54}) {
+      Simulator sim(s.model, s.constraints, solverNumber(which, s.model, s.constraints), it);
+      ASSERT_TRUE(sim.setState(0, q, v));
+      long allocations = 0, pieces = 0;
+      while (sim.time() < 1.0) {
+        StepStatus st;
+        {
+          Arm arm;
+          st = sim.step(2e-3);
+          allocations += g_allocations;
+        }
+        ASSERT_TRUE(st.ok) << st.message;
+        for (const ContactEvent& e : sim.events()) pieces += e.kind == ContactEventKind::Feature;
+      }
+      EXPECT_EQ(pieces, 2) << "solver " << which << ", " << toString(it);
+      EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
+      EXPECT_TRUE(sim.isClosed(0));
     }
   }
 }

@@ -45,11 +45,12 @@ void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out) {
 void contactGeometry(const Shape& shape, const SupportSurface& surface,
                      const SupportState& support, const SE3& body_pose,
                      const Vec6& body_velocity, ContactGeometry& out,
-                     const GeometryOptions& options) {
+                     const GeometryOptions& options, int latched_feature) {
   out.singular = false;
   out.reason = nullptr;
   out.margin = 1;
   out.iterations = 0;
+  out.feature = -1;
   if (!isSmoothContactShape(shape)) {
     out = ContactGeometry{};
     detail::markSingular(out, "collision-only shape has no smooth contact point");
@@ -65,7 +66,7 @@ void contactGeometry(const Shape& shape, const SupportSurface& surface,
                  },
                  [&](const TerrainMesh& t) {
                    detail::terrainGeometry(shape, t, support, body_pose, body_velocity, out,
-                                           options);
+                                           options, latched_feature);
                  }},
              surface);
 }

@@ -202,7 +202,9 @@ void ShapeContact::geometry(const SE3& body_pose, const Vec6& body_velocity, dou
 void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
                              const SupportState& S, RowBlock& out) const {
   ContactGeometry g;
-  contactGeometry(spec_.shape, spec_.support.surface, S, body_pose, body_velocity, g, spec_.options.geometry);
+  contactGeometry(spec_.shape, spec_.support.surface, S, body_pose, body_velocity, g,
+                  spec_.options.geometry, out.latched_feature);
+  out.feature = g.feature;
   out.m = rows_;
   out.Wa.resize(rows_, 6);
   out.Wb.resize(rows_, 6);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace appell {
 
@@ -80,6 +81,7 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
   }
   // Edge (i, j) with i < j (welded) → (face, local vertex opposite the edge).
   std::map<std::pair<int, int>, std::pair<int, int>> edges;
+  idx->edge.assign(nf, {-1, -1, -1});
   for (int f = 0; f < nf; ++f) {
     const auto& tri = t.triangles[f];
     idx->normal[f] = terrainFaceNormal(t, f);
@@ -87,7 +89,11 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
       const int a = weld[tri[(k + 1) % 3]], b = weld[tri[(k + 2) % 3]];
       const auto key = std::minmax(a, b);
       auto [it, fresh] = edges.emplace(key, std::make_pair(f, k));
-      if (!fresh) {
+      if (fresh) {
+        idx->edge[f][k] = static_cast<int>(idx->edge_ends.size());
+        idx->edge_ends.push_back({key.first, key.second});
+      } else {
+        idx->edge[f][k] = idx->edge[it->second.first][it->second.second];
         // A third face on one edge is not a surface; keep the first pair.
         if (idx->neighbour[it->second.first][it->second.second] < 0) {
           idx->neighbour[it->second.first][it->second.second] = f;
@@ -96,12 +102,73 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
       }
     }
   }
+  // Regions: faces joined across edges whose two planes coincide (normals
+  // equal and each face's vertices on the other's plane, to round-off).
+  idx->region.assign(nf, -1);
+  for (int f0 = 0; f0 < nf; ++f0) {
+    if (idx->region[f0] >= 0) continue;
+    const int r = static_cast<int>(idx->region_face.size());
+    idx->region_face.push_back(f0);
+    idx->region[f0] = r;
+    std::vector<int> stack{f0};
+    while (!stack.empty()) {
+      const int f = stack.back();
+      stack.pop_back();
+      for (int k = 0; k < 3; ++k) {
+        const int j = idx->neighbour[f][k];
+        if (j < 0 || idx->region[j] >= 0) continue;
+        const auto& tj = t.triangles[j];
+        const double scale = (t.vertices[tj[1]] - t.vertices[tj[0]]).norm() +
+                             (t.vertices[tj[2]] - t.vertices[tj[0]]).norm();
+        const Vec3& a = t.vertices[t.triangles[f][0]];
+        const bool coplanar = (idx->normal[j] - idx->normal[f]).norm() <= 1e-12 &&
+                              std::abs(idx->normal[f].dot(t.vertices[tj[0]] - a)) <= 1e-12 * scale &&
+                              std::abs(idx->normal[f].dot(t.vertices[tj[1]] - a)) <= 1e-12 * scale &&
+                              std::abs(idx->normal[f].dot(t.vertices[tj[2]] - a)) <= 1e-12 * scale;
+        if (!coplanar) continue;
+        idx->region[j] = r;
+        stack.push_back(j);
+      }
+    }
+  }
+  idx->regions = static_cast<int>(idx->region_face.size());
+  idx->edges = static_cast<int>(idx->edge_ends.size());
+  idx->weld = std::move(weld);
   idx->bvh = detail::buildHierarchy(t.vertices, t.triangles, true);
   if (!idx->bvh) fail("FCL could not build its bounding-volume hierarchy");
   idx->depth = hierarchyDepth(*idx->bvh, 0);
   if (idx->depth >= detail::kTerrainStack) fail("bounding-volume hierarchy too deep");
   t.index = std::move(idx);
   return t;
+}
+
+std::string terrainFeatureName(const TerrainMesh& t, int feature) {
+  if (!t.index || feature < 0) return "no piece";
+  const TerrainIndex& idx = *t.index;
+  const int nf = static_cast<int>(t.triangles.size());
+  if (feature < idx.regions) {
+    std::string faces;
+    int count = 0;
+    for (int f = 0; f < nf; ++f) {
+      if (idx.region[f] != feature) continue;
+      if (++count <= 4) faces += (count > 1 ? ", " : "") + std::to_string(f);
+    }
+    if (count == 1) return "face " + faces;
+    return "flat region of faces " + faces + (count > 4 ? ", … (" + std::to_string(count) + ")" : "");
+  }
+  feature -= idx.regions;
+  if (feature < idx.edges) {
+    int first = -1, second = -1;
+    for (int f = 0; f < nf && second < 0; ++f)
+      for (int k = 0; k < 3; ++k)
+        if (idx.edge[f][k] == feature) {
+          if (first < 0) first = f;
+          else if (f != first) second = f;
+        }
+    if (second < 0) return "boundary edge of face " + std::to_string(first);
+    return "edge between faces " + std::to_string(first) + " and " + std::to_string(second);
+  }
+  return "vertex " + std::to_string(feature - idx.edges);
 }
 
 namespace detail {

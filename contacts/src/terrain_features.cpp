@@ -54,7 +54,7 @@ double boundingRadius(const Shape& shape) {
 
 bool terrainEdgeGeometry(const Shape& shape, const Vec3& a_s, const Vec3& b_s,
                          const SupportState& S, const SE3& pose, const Vec6& V,
-                         ContactGeometry& out, const GeometryOptions& opt) {
+                         ContactGeometry& out, const GeometryOptions& opt, bool segment) {
   const Twist body(V), sup(S.V);
   const Vec3 a = S.pose.apply(a_s);
   const Vec3 ab = S.pose.R * (b_s - a_s);
@@ -93,7 +93,7 @@ bool terrainEdgeGeometry(const Shape& shape, const Vec3& a_s, const Vec3& b_s,
   y = pose.apply(g.y);
   gap = n.dot(y - a);
   const double along = e.dot(y - a);
-  if (along < 0 || along > length) return false;  // nearest to the line beyond the segment
+  if (segment && (along < 0 || along > length)) return false;  // nearest to the line beyond it
 
   const Vec3 bb = pose.R.transpose() * b;
   const Mat3 RSR = pose.R * g.Sigma * pose.R.transpose();

@@ -25,10 +25,12 @@ Vec3 barycentric(const TerrainMesh& t, const TerrainIndex& idx, int f, const Vec
          area;
 }
 
-constexpr double kInsideTol = 1e-9;
+constexpr double kInsideTol = 1e-12;
 /// Depth below which an edge or vertex contact is accepted (m): the drift the
 /// projection leaves is orders of magnitude smaller.
 constexpr double kFeatureDepth = 1e-6;
+/// How much nearer than a holding face an edge or vertex must be (m).
+constexpr double kFaceMargin = 1e-12;
 
 // Reason text naming the edge or vertex; a per-thread buffer so that setting
 // it does not allocate (valid until this thread's next terrain query).
@@ -63,11 +65,43 @@ const char* edgeReason(const TerrainMesh& t, const TerrainIndex& idx, int f, con
   return text;
 }
 
+// The contact with one feature, extended past its bounds: a region's plane
+// beyond its faces, an edge's line beyond its ends. Between events the
+// simulator keeps each closed contact on the feature it had at the event
+// (docs/contacts.md §4): the dynamics inside a step are then smooth, and a
+// change of feature is an event located for all contacts together.
+void latchedGeometry(const Shape& shape, const TerrainMesh& t, int feature, const SupportState& S,
+                     const SE3& pose, const Vec6& V, ContactGeometry& out,
+                     const GeometryOptions& opt) {
+  const TerrainIndex& idx = *t.index;
+  out.singular = false;
+  out.reason = nullptr;
+  if (feature < idx.regions) {
+    Plane plane;
+    plane.point = t.vertices[t.triangles[idx.region_face[feature]][0]];
+    plane.normal = idx.normal[idx.region_face[feature]];
+    planeGeometry(shape, plane, S, pose, V, out, opt);
+  } else if (feature < idx.regions + idx.edges) {
+    const auto& ends = idx.edge_ends[feature - idx.regions];
+    if (!terrainEdgeGeometry(shape, t.vertices[ends[0]], t.vertices[ends[1]], S, pose, V, out, opt,
+                             false))
+      markSingular(out, "no contact with the terrain edge the contact is latched to (the body "
+                        "lies across its line)");
+  } else if (feature < idx.regions + idx.edges + static_cast<int>(t.vertices.size())) {
+    if (!terrainVertexGeometry(shape, t.vertices[feature - idx.regions - idx.edges], S, pose, V,
+                               out, opt))
+      markSingular(out, "no contact with the terrain vertex the contact is latched to");
+  } else {
+    markSingular(out, "latched terrain feature out of range");
+  }
+  out.feature = feature;
+}
+
 }  // namespace
 
 void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const SupportState& S,
                      const SE3& pose, const Vec6& V, ContactGeometry& out,
-                     const GeometryOptions& opt) {
+                     const GeometryOptions& opt, int latched) {
   if (!terrain.index) {
     out = ContactGeometry{};
     markSingular(out, "terrain index not built (create the mesh with makeTerrain)");
@@ -75,7 +109,11 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
   }
   const TerrainIndex& idx = *terrain.index;
   if (const auto* sphere = std::get_if<Sphere>(&shape)) {
-    terrainSphereGeometry(*sphere, terrain, S, pose, V, out, opt);
+    terrainSphereGeometry(*sphere, terrain, S, pose, V, out, opt, latched);
+    return;
+  }
+  if (latched >= 0) {
+    latchedGeometry(shape, terrain, latched, S, pose, V, out, opt);
     return;
   }
 
@@ -102,7 +140,7 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
   // The body's bounding sphere (support frame): centre and radius.
   const Vec3 c_s = inv.apply(pose.apply(shapeCentre(shape)));
   const double bound = boundingRadius(shape);
-  int best = -1, nearest = -1;
+  int best = -1, nearest = -1, best_feature = -1;
   double nearest_gap = INFINITY;  // the ranking score below
   Vec3 nearest_lambda = Vec3::Zero();
   auto consider = [&](int f) {
@@ -117,6 +155,7 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
     if (lambda.minCoeff() >= -kInsideTol) {
       if (best < 0 || trial.gap < out.gap) {
         best = f;
+        best_feature = idx.regionFeature(f);
         out = trial;
       }
       return;
@@ -128,8 +167,14 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
     // nearer than the best contact so far is worth those solves. An edge or
     // vertex is a distance, not a signed depth: one that the body has sunk
     // past by more than drift (kFeatureDepth) says nothing about the contact.
+    // Near a convex edge the edge's gap exceeds the face's by only
+    // O(distance² / radius): an edge or vertex must beat a holding face by
+    // more than round-off (kFaceMargin), or the piece flickers to the edge
+    // before the contact point reaches it.
     auto better = [&](const ContactGeometry& g) {
-      return g.gap >= -kFeatureDepth && (best < 0 || g.gap < out.gap);
+      if (g.gap < -kFeatureDepth) return false;
+      if (best < 0) return true;
+      return g.gap < out.gap - (best_feature < idx.regions ? kFaceMargin : 0.0);
     };
     // A second, sharper lower bound: the distance from the body's bounding
     // sphere to the triangle.
@@ -141,15 +186,21 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
         bound;
     if (best < 0 || (trial.gap < out.gap && reach < out.gap)) {
       for (int k = 0; k < 3; ++k) {
-        if (terrainEdgeGeometry(shape, terrain.vertices[tri[(k + 1) % 3]],
-                                terrain.vertices[tri[(k + 2) % 3]], S, pose, V, feature, opt) &&
+        // Each edge with its welded ends in one order, whichever face offers
+        // it, so that its tangent frame is the latched edge's (same rows).
+        const auto& ends = idx.edge_ends[idx.edge[f][k]];
+        if (terrainEdgeGeometry(shape, terrain.vertices[ends[0]], terrain.vertices[ends[1]], S,
+                                pose, V, feature, opt) &&
             better(feature)) {
           best = f;
+          best_feature = idx.edgeFeature(f, k);
           out = feature;
         }
-        if (terrainVertexGeometry(shape, terrain.vertices[tri[k]], S, pose, V, feature, opt) &&
+        if (terrainVertexGeometry(shape, terrain.vertices[idx.weld[tri[k]]], S, pose, V, feature,
+                                  opt) &&
             better(feature)) {
           best = f;
+          best_feature = idx.vertexFeature(tri[k]);
           out = feature;
         }
       }
@@ -197,7 +248,11 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
                         ((qhi - (root.To + root_half)).array() >= 0).all();
     if (covers) break;
   }
-  if (best >= 0) return;
+  if (best >= 0) {
+    out.feature = best_feature;
+    return;
+  }
+  out.feature = -1;
   if (nearest < 0) {
     markSingular(out, "no terrain face near the body");
     return;

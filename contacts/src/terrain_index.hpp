@@ -24,6 +24,21 @@ struct TerrainIndex {
   std::vector<Vec3> normal;                      ///< unit face normals (support frame)
   /// neighbour[f][k]: the face across the edge opposite vertex k of f, or −1.
   std::vector<std::array<int, 3>> neighbour;
+  // Features: the pieces a contact can touch, each with one id
+  // (ContactGeometry::feature). A *region* is a set of edge-connected faces on
+  // one plane — a flat patch of many triangles is one piece, since the plane
+  // contact is the same on all of them; then the edges (welded vertex pairs)
+  // and the (welded) vertices:
+  //   region r → r,   edge e → regions + e,   vertex v → regions + edges + v.
+  std::vector<int> region;                       ///< per face: its region
+  std::vector<int> region_face;                  ///< per region: one of its faces
+  std::vector<std::array<int, 3>> edge;          ///< per face: the id of its edge k (opposite vertex k)
+  std::vector<std::array<int, 2>> edge_ends;     ///< per edge: its two (welded) vertices
+  std::vector<int> weld;                         ///< per vertex: the first vertex at its position
+  int regions = 0, edges = 0;
+  int regionFeature(int f) const { return region[f]; }
+  int edgeFeature(int f, int k) const { return regions + edge[f][k]; }
+  int vertexFeature(int v) const { return regions + edges + weld[v]; }
   /// FCL's hierarchy over the triangles (one triangle per leaf, leaf
   /// primitiveId() = index into TerrainMesh::triangles).
   std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> bvh;
@@ -72,16 +87,19 @@ void forEachFaceInBox(const TerrainIndex& index, const Vec3& lo, const Vec3& hi,
 /// The contact geometry of a shape on a terrain (terrain.hpp): the plane
 /// geometry of the holding face with the smallest gap, or singular over an
 /// edge or vertex.
+/// `latched` ≥ 0: with that feature only (TerrainIndex numbers them),
+/// extended past its bounds.
 void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const SupportState& S,
                      const SE3& pose, const Vec6& V, ContactGeometry& out,
-                     const GeometryOptions& opt);
+                     const GeometryOptions& opt, int latched = -1);
 
 /// A sphere on a terrain: the contact at the mesh point nearest to its
-/// centre — on a face (the plane contact), an edge or a vertex
+/// centre — on a face (the plane contact), an edge or a vertex — or at the
+/// nearest point of the latched feature's plane, line or vertex
 /// (terrain_sphere.cpp).
 void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
-                           const GeometryOptions& opt);
+                           const GeometryOptions& opt, int latched);
 
 /// A point of the shape to measure from (its centre; a pose origin for the
 /// collision-only shapes) and the radius of a ball about it holding the shape.
@@ -91,11 +109,12 @@ double boundingRadius(const Shape& shape);
 Vec3 nearestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
 /// A smooth shape against the terrain edge from a_s to b_s (support frame):
-/// false when the nearest point of the line lies beyond the segment, the
-/// solve does not converge, or the contact is singular (terrain_features.cpp).
+/// false when the nearest point of the line lies beyond the segment (only
+/// when `segment`: a latched edge is its whole line), the solve does not
+/// converge, or the contact is singular (terrain_features.cpp).
 bool terrainEdgeGeometry(const Shape& shape, const Vec3& a_s, const Vec3& b_s,
                          const SupportState& S, const SE3& pose, const Vec6& V,
-                         ContactGeometry& out, const GeometryOptions& opt);
+                         ContactGeometry& out, const GeometryOptions& opt, bool segment = true);
 /// A smooth shape against the terrain vertex x_s: false when singular.
 bool terrainVertexGeometry(const Shape& shape, const Vec3& x_s, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,

@@ -67,50 +67,87 @@ Vec3 nearestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 
 void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
-                           const GeometryOptions& opt) {
+                           const GeometryOptions& opt, int latched) {
   const TerrainIndex& idx = *terrain.index;
   const Twist body(V), sup(S.V);
   const Vec3 c = pose.apply(sphere.centre);
   const Vec3 cs = S.pose.applyInv(c);  // support frame
 
-  // Candidate faces: every triangle within distance r of the centre meets the
-  // box cs ± r; r widens until the nearest point found lies within it.
-  Nearest best;
-  double best_d2 = INFINITY;
-  auto consider = [&](int f) {
-    const auto& tri = terrain.triangles[f];
-    Nearest n = nearestOnTriangle(cs, terrain.vertices[tri[0]], terrain.vertices[tri[1]],
-                                  terrain.vertices[tri[2]]);
-    const double d2 = (cs - n.x).squaredNorm();
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      n.face = f;
-      best = n;
+  // The feature (TerrainIndex's numbering) and its point nearest the centre:
+  // the latched one extended (a region's plane, an edge's line), or the
+  // nearest over the mesh.
+  int feature = latched;
+  Vec3 xs = Vec3::Zero();
+  if (latched < 0) {
+    // Candidate faces: every triangle within distance r of the centre meets
+    // the box cs ± r; r widens until the nearest point found lies within it.
+    // Ties go to a face (a point on an edge or vertex inside a flat region
+    // is on the region).
+    Nearest best;
+    double best_d2 = INFINITY;
+    auto consider = [&](int f) {
+      const auto& tri = terrain.triangles[f];
+      Nearest n = nearestOnTriangle(cs, terrain.vertices[tri[0]], terrain.vertices[tri[1]],
+                                    terrain.vertices[tri[2]]);
+      const double d2 = (cs - n.x).squaredNorm();
+      if (d2 < best_d2 || (n.feature == 0 && best.feature != 0 && d2 <= best_d2 * (1 + 1e-12))) {
+        best_d2 = std::min(d2, best_d2);
+        n.face = f;
+        best = n;
+      }
+    };
+    const auto& root = idx.bvh->getBV(0).bv.obb;
+    const Vec3 root_half = root.axis.cwiseAbs() * root.extent;
+    for (double r = 2 * sphere.radius;;
+         r = std::isfinite(best_d2) ? std::sqrt(best_d2) * (1 + 1e-9) + 1e-12 : 2 * r) {
+      const Vec3 lo = cs.array() - r, hi = cs.array() + r;
+      forEachFaceInBox(idx, lo, hi, consider);
+      if (best_d2 <= r * r) break;
+      if (((lo - (root.To - root_half)).array() <= 0).all() &&
+          ((hi - (root.To + root_half)).array() >= 0).all())
+        break;
     }
-  };
-  const auto& root = idx.bvh->getBV(0).bv.obb;
-  const Vec3 root_half = root.axis.cwiseAbs() * root.extent;
-  for (double r = 2 * sphere.radius;; r = std::isfinite(best_d2) ? std::sqrt(best_d2) * (1 + 1e-9) + 1e-12 : 2 * r) {
-    const Vec3 lo = cs.array() - r, hi = cs.array() + r;
-    forEachFaceInBox(idx, lo, hi, consider);
-    if (best_d2 <= r * r) break;
-    if (((lo - (root.To - root_half)).array() <= 0).all() &&
-        ((hi - (root.To + root_half)).array() >= 0).all())
-      break;
+    const int f = best.face;
+    const auto& tri = terrain.triangles[f];
+    // On an edge or a vertex but along the face's normal (its boundary, or
+    // an edge between coplanar faces): the face's plane contact.
+    const Vec3 d = cs - best.x;
+    const Vec3& nf = idx.normal[f];
+    const bool on_plane = nf.dot(d) >= 0 && (d - nf * nf.dot(d)).norm() <= 1e-12 * d.norm();
+    if (best.feature == 0 || on_plane) feature = idx.regionFeature(f);
+    else if (best.feature <= 3) feature = idx.edgeFeature(f, best.feature - 1);
+    else feature = idx.vertexFeature(tri[best.feature - 4]);
+    if (feature >= idx.regions + idx.edges) xs = terrain.vertices[feature - idx.regions - idx.edges];
+    else xs = best.x;
   }
-
-  const int f = best.face;
-  if (best.feature == 0) {
-    // Inside a face: the plane contact of that face, exactly.
+  if (feature < idx.regions) {
+    // On a flat region: the plane contact of its plane, exactly.
     Plane plane;
-    plane.point = terrain.vertices[terrain.triangles[f][0]];
-    plane.normal = idx.normal[f];
+    plane.point = terrain.vertices[terrain.triangles[idx.region_face[feature]][0]];
+    plane.normal = idx.normal[idx.region_face[feature]];
     planeGeometry(sphere, plane, S, pose, V, out, opt);
+    out.feature = feature;
     return;
   }
-  const Vec3 x = S.pose.apply(best.x);
+  const bool on_edge = feature < idx.regions + idx.edges;
+  Vec3 e;  // tangent reference: the edge (its welded ends in order), or a support axis away from n
+  if (on_edge) {
+    const auto& ends = idx.edge_ends[feature - idx.regions];
+    const Vec3& a = terrain.vertices[ends[0]];
+    const Vec3 es = (terrain.vertices[ends[1]] - a).normalized();
+    if (latched >= 0) xs = a + es * es.dot(cs - a);  // the line's point nearest the centre
+    e = S.pose.R * es;
+  } else if (feature < idx.regions + idx.edges + static_cast<int>(terrain.vertices.size())) {
+    xs = terrain.vertices[feature - idx.regions - idx.edges];
+  } else {
+    out = ContactGeometry{};
+    markSingular(out, "latched terrain feature out of range");
+    return;
+  }
+  const Vec3 x = S.pose.apply(xs);
   const double d = (c - x).norm();
   out = ContactGeometry{};
+  out.feature = feature;
   if (!(d > opt.singular_tol * sphere.radius)) {
     out.point = c;
     out.support_point = x;
@@ -120,12 +157,8 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
   }
   const Vec3 n = (c - x) / d;
   const Vec3 u = body.at(c) - S.pointVelocity(c);
-  Vec3 e;  // tangent reference: the edge, or a support axis away from n
   Vec3 ndot = sup.w.cross(n);
-  if (best.feature <= 3) {
-    const auto& tri = terrain.triangles[f];
-    const int k = best.feature - 1;
-    e = S.pose.R * (terrain.vertices[tri[(k + 2) % 3]] - terrain.vertices[tri[(k + 1) % 3]]).normalized();
+  if (on_edge) {
     const Vec3 pu = u - e * e.dot(u);
     ndot += (pu - n * n.dot(pu)) / d;
   } else {

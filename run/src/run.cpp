@@ -3,6 +3,9 @@
 #include "step_stability.hpp"
 #include "vertex_watch.hpp"
 
+#include <appell/contacts.hpp>
+#include <appell/terrain.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -165,6 +168,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
       r.tangential_impulse = ev.tangential_impulse;
       r.outside_friction_cone =
           ev.tangential_impulse > s.contacts[ev.constraint].mu * ev.normal_impulse * (1 + 1e-9);
+      const auto* c = dynamic_cast<const ShapeContact*>(scene.constraints[ev.constraint].get());
+      if (ev.kind == ContactEventKind::Feature && c)
+        if (const auto* mesh = std::get_if<TerrainMesh>(&c->spec().support.surface))
+          r.piece = terrainFeatureName(*mesh, ev.feature);
       s.events.push_back(std::move(r));
     }
   };

@@ -37,6 +37,10 @@ struct ContactGeometry {
   const char* reason = nullptr;       ///< static text, set when singular
   double margin = 1;                  ///< GaussPoint::margin of the body's point (1: no singular limit)
   int iterations = 0;                 ///< Newton iterations (ellipsoid on a sphere), else 0
+  /// The piece of a piecewise support the contact is on — a terrain's flat
+  /// region, edge or vertex (terrain.hpp numbers them) — or −1 on a smooth
+  /// support.
+  int feature = -1;
 };
 
 struct GeometryOptions {
@@ -53,9 +57,12 @@ struct GeometryOptions {
 /// Computes `out` for a shape on a support surface. `body_velocity` is the
 /// world spatial velocity [ω; v_O]. Singular or invalid configurations set
 /// out.singular and out.reason and leave finite values (never NaN).
+/// `latched_feature` ≥ 0 (a value of out.feature): the contact with that piece
+/// of a terrain only, extended past its bounds — the simulator keeps a closed
+/// contact on one piece between events (docs/contacts.md §4); −1 searches.
 void contactGeometry(const Shape& shape, const SupportSurface& surface,
                      const SupportState& support, const SE3& body_pose,
                      const Vec6& body_velocity, ContactGeometry& out,
-                     const GeometryOptions& options = {});
+                     const GeometryOptions& options = {}, int latched_feature = -1);
 
 }  // namespace appell

@@ -35,6 +35,7 @@
 
 #include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace appell {
@@ -60,5 +61,10 @@ void validateTerrain(const TerrainMesh& terrain);
 
 /// Unit normal of triangle `face` from its winding (support frame).
 Vec3 terrainFaceNormal(const TerrainMesh& terrain, int face);
+
+/// Names a contact's piece of the terrain (ContactGeometry::feature): "face 3"
+/// (a flat region of several faces: "flat region of faces 3, 4, …"), "edge
+/// between faces 2 and 3" (or "boundary edge of face 2"), "vertex 7".
+std::string terrainFeatureName(const TerrainMesh& terrain, int feature);
 
 }  // namespace appell

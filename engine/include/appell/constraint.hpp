@@ -72,6 +72,13 @@ struct RowBlock {
   MatX A_joint;                     ///< jointSpace(): m × joint_cols.size()
   VecX b_joint, abias_joint;        ///< jointSpace(): b and Ȧv + ḃ (size m)
   ContactFrame frame;
+  /// A contact on a piecewise support (a terrain's flat regions, edges and
+  /// vertices): the piece these rows are for (−1: a smooth support). With
+  /// `latched_feature` ≥ 0 the contact is evaluated on that piece, extended
+  /// past its bounds, instead of the nearest one: the simulator keeps a
+  /// closed contact on one piece between events (docs/contacts.md §4).
+  int feature = -1;
+  int latched_feature = -1;
   bool singular = false;            ///< the geometry is singular here (rows unusable)
   std::string singular_reason;      ///< why, when singular (set only then)
 };

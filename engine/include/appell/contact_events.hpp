@@ -56,9 +56,10 @@ enum class ContactEventKind {
   LiftOff,    ///< a closed contact's normal force reached 0; it opened
   Slip,       ///< a sticking contact's friction demand reached μ: it slides
   Stick,      ///< a sliding contact's slip stopped and sticking holds: it sticks
+  Feature,    ///< a closed contact moved onto another face, edge or vertex of a terrain
 };
-/// "touchdown", "bounce", "lift_off", "slip", "stick": the names of the run
-/// summary and CSV.
+/// "touchdown", "bounce", "lift_off", "slip", "stick", "feature": the names of
+/// the run summary and CSV.
 std::span<const NamedValue<ContactEventKind>> contactEventKindTable();
 const char* toString(ContactEventKind kind);
 
@@ -70,6 +71,7 @@ struct ContactEvent {
   double speed_after = 0;         ///< after the impact
   double normal_impulse = 0;      ///< Λᵤ ≥ 0 (0 without an impact)
   double tangential_impulse = 0;  ///< |impulse of the tangent/lateral rows| (friction demand)
+  int feature = -1;               ///< Feature: the piece it moved onto (RowBlock::feature)
 };
 
 struct ContactEventOptions {
@@ -91,6 +93,14 @@ struct ContactEventOptions {
   /// accelerate along itself, instead of integrating that direction's
   /// relaxation (rate 1/settle_time and faster: docs/contacts.md §8). 0: never.
   double settle_time = 1e-4;
+  /// A closed contact on a terrain stays on its face, edge or vertex
+  /// (extended past its bounds) between events; reaching another is an event.
+  /// Contacts that reach theirs within this time of the first one switch
+  /// with it: a rigid car's two wheels crossing an edge side by side, a
+  /// round-off apart, must not see each other on different pieces
+  /// (docs/contacts.md §4). A switch early by δ = speed · window moves a
+  /// rolling body by O(δ²/radius).
+  double feature_window = 1e-6;
   int max_mode_iterations = 64;   ///< pivots of one complementarity problem
   int max_locate_iterations = 60; ///< root-finding iterations per event
 };

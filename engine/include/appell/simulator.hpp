@@ -190,15 +190,21 @@ class Simulator {
   /// (friction_overconstrained.cpp).
   int overconstrainedContact(double t, const VecX& q, const VecX& v);
   Vec3 frictionForce(int k, const VecX& lambda) const;
-  StepStatus locateAndHandleEvent(StepStatus st, double h);
+  /// `k`, `type`: a crossing already found (−1: look for one).
+  StepStatus locateAndHandleEvent(StepStatus st, double h, int k = -1,
+                                  detail::Crossing type = detail::Crossing{});
   double eventFunction(int u, detail::Crossing type);
   bool restepTo(double tau, StepStatus& st);
   /// work_ after an integrator step from the last step's start.
   void takeStepWork(const StepResult& r);
   bool decideModes(std::string& error);
-  /// `rows_current` on return: no impact, so cdata_/data_ still hold the rows
-  /// at the step's end (t_, q_, v_) that the check evaluated.
-  bool featureSwitchImpact(std::string& error, bool& rows_current);
+  bool pointJumpImpact(std::string& error, bool& rows_current);
+  // Contacts on piecewise supports (simulator/contact_features.cpp).
+  void applyLatches();
+  int searchFeatures();
+  bool searchedRowsLatched() const;
+  void acceptFeatures();
+  void switchFeatures(bool lookahead);
   bool projectAfterModes(std::string& error);
   bool impactPhase(std::string& error);
   bool forcePhase(std::string& error);

@@ -20,6 +20,7 @@ std::span<const NamedValue<ContactEventKind>> contactEventKindTable() {
       {ContactEventKind::LiftOff, "lift_off", {"liftoff"}, "a closed contact's normal force reached 0: it opened"},
       {ContactEventKind::Slip, "slip", {}, "a sticking contact's friction demand reached μ: it slides"},
       {ContactEventKind::Stick, "stick", {}, "a sliding contact stopped slipping and sticking holds"},
+      {ContactEventKind::Feature, "feature", {}, "a closed contact moved onto another face, edge or vertex of a terrain"},
   };
   return table;
 }
@@ -107,6 +108,7 @@ void Simulator::setUpUnilateral() {
   u.over_W = MatX::Zero(nf, nf);
   u.over_g = VecX::Zero(nf);
   u.over_eig = Eigen::SelfAdjointEigenSolver<MatX>(nf);
+  u.feature_ahead.assign(u.rows.size(), -1);
 }
 
 // ---------------------------------------------------------------- detection
@@ -173,6 +175,7 @@ bool Simulator::restepTo(double tau, StepStatus& st) {
 double Simulator::eventFunction(int k, detail::Crossing type) {
   using detail::Crossing;
   const UnilateralRow& r = uni_->rows[k];
+  if (type == Crossing::Feature) return searchFeatures() >= 0 ? -1.0 : 1.0;  // any switched
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   if (type == Crossing::Gap) return cdata_->gap[r.global];
   if (type == Crossing::Slip) return cdata_->slide[r.c].slip.dot(r.dir_start);
@@ -184,15 +187,16 @@ double Simulator::eventFunction(int k, detail::Crossing type) {
   return r.mu * fn - frictionForce(k, uni_->res.lambda).norm();
 }
 
-StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
+StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h, int k,
+                                           detail::Crossing type) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
   // The step's start: the last good state (t_prev_ …), saved by step().
   u.t0 = t_prev_;
   u.q0 = q_prev_;
   u.v0 = v_prev_;
-  detail::Crossing type = detail::Crossing::None;
-  int k = crossedConstraint(type);
+  if (k < 0) k = crossedConstraint(type);
+  bool feature = type == detail::Crossing::Feature;  // a piece switch among the events
   double hi = h;
   // The event functions along the step: on the integrator's dense output
   // when it has one (Dormand–Prince: no new evaluations), else on steps from
@@ -239,7 +243,8 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     } else {
       int side = 0;
       for (int it = 0; it < o.max_locate_iterations && b - a > o.time_tol; ++it) {
-        double c = (a * fb - b * fa) / (fb - fa);
+        // (A switch of piece is a step function: bisection.)
+        double c = type == detail::Crossing::Feature ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
         if (!(c > a && c < b)) c = 0.5 * (a + b);
         if (!stateAt(c)) return fail(st, "event location: a shortened step failed");
         c = t_ - u.t0;  // an adaptive method may have taken less than asked
@@ -262,11 +267,15 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     // Did another contact cross before τ = b? Then that one is first.
     if (!stateAt(b)) return fail(st, "event location: a shortened step failed");
     hi = t_ - u.t0;
-    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     int earlier = -1;
     detail::Crossing earlier_type = detail::Crossing::None;
+    if (type != detail::Crossing::Feature) {
+      earlier = searchFeatures();
+      if (earlier >= 0) earlier_type = detail::Crossing::Feature;
+    }
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     for (int j = 0; j < static_cast<int>(u.rows.size()) && earlier < 0; ++j) {
-      if (j == k) continue;
+      if (j == k && type != detail::Crossing::Feature) continue;
       const UnilateralRow& r = u.rows[j];
       if (!cdata_->isActive(r.c)) {
         if (cdata_->gap[r.global] < -o.gap_tol) earlier = j, earlier_type = detail::Crossing::Gap;
@@ -283,6 +292,16 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
     if (earlier < 0) break;
     k = earlier;
     type = earlier_type;
+    feature = feature || type == detail::Crossing::Feature;
+  }
+  if (feature) {
+    // The pieces feature_window later: contacts switching that soon after
+    // the first switch with it (contact_features.cpp).
+    if (!stateAt(std::min(hi + o.feature_window, h)))
+      return fail(st, "event location: a shortened step failed");
+    searchFeatures();
+    for (int j = 0; j < static_cast<int>(u.rows.size()); ++j) u.feature_ahead[j] = u.rows[j].feature_free;
+    if (!dense && !stateAt(hi)) return fail(st, "event location: a shortened step failed");
   }
   if (dense && !restepTo(hi, st))  // the step itself, to the event
     return fail(st, "event location: the step to the event failed");
@@ -302,11 +321,13 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
   if (type == detail::Crossing::Normal) ev.lifting = true;
   if (type == detail::Crossing::Gap) ev.touching_down = true;
   st.h_taken = hi;
-  // Drift control on the old set (the closed rows' velocity drift is not
-  // slip, the open ones' approach speed stays), the modes, then drift
+  // Drift control on the old set and pieces (the closed rows' velocity drift
+  // is not slip, the open ones' approach speed stays); the new pieces (a
+  // contact may now approach its new one: an impact), the modes, then drift
   // control on the new set.
   std::string error;
   if (!projectAfterModes(error)) return fail(st, error);
+  switchFeatures(feature);
   const double T_before = appell::kineticEnergy(model_, *data_, q_, v_);
   if (type == detail::Crossing::Cone || type == detail::Crossing::Slip) {
     // Friction: the contact starts sliding against its sticking force, or
@@ -336,6 +357,7 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h) {
   if (!projectAfterModes(error)) return fail(st, error);
   dissipated_ += T_before - appell::kineticEnergy(model_, *data_, q_, v_);
   for (auto& r : u.rows) r.dir_start = r.dir;  // the next step's slip reference
+  applyLatches();  // contacts that closed keep the piece they touched down on
   integrator_->reset();
   if (!evaluateEndState(error)) return fail(st, error);
   st.events = static_cast<int>(events_.size());
@@ -434,7 +456,11 @@ void Simulator::logEvent(ContactEventKind kind, int k, double before, double aft
   e.speed_before = before;
   e.speed_after = after;
   e.normal_impulse = impulse;
-  e.tangential_impulse = r.tangential;
+  // The friction impulse of this event's impact (none for a lift-off, a
+  // stick or a change of piece, whatever impact came before).
+  const bool impact = kind == ContactEventKind::Touchdown || kind == ContactEventKind::Bounce ||
+                      kind == ContactEventKind::Slip;
+  e.tangential_impulse = impact ? r.tangential : 0;
   events_.push_back(e);
 }
 
@@ -698,18 +724,20 @@ bool Simulator::decideModes(std::string& error) {
   return impactPhase(error) && forcePhase(error);
 }
 
-/// A closed contact whose nearest feature changed inside the step — a wheel
-/// rolling into a concave terrain crease meets the rising face — approaches
-/// its new feature at the step's end faster than rest_speed. That is an
-/// impact: resolved here, at the step's end (not yet located inside the step),
-/// by the same impact and force problems as a touchdown, its energy loss
-/// counted — instead of being absorbed unseen by the drift projection.
-bool Simulator::featureSwitchImpact(std::string& error, bool& rows_current) {
+/// A closed contact whose contact point jumped inside the step — a disk
+/// falling flat, whose lowest rim point runs round the rim — approaches the
+/// support at the step's end faster than rest_speed. That is an impact:
+/// resolved here, at the step's end, by the same impact and force problems as
+/// a touchdown, its energy loss counted — instead of being absorbed unseen by
+/// the drift projection. (A terrain's change of piece is located instead:
+/// contact_features.cpp.) `rows_current` on entry: cdata_ and data_ hold the
+/// rows at (t_, q_, v_); on return: they still do (no impact).
+bool Simulator::pointJumpImpact(std::string& error, bool& rows_current) {
   auto& u = *uni_;
-  rows_current = false;
   // The rows at the step's end; their forward kinematics (q, v) leave the
   // bodies' velocities in data_ for the normal velocities below.
-  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  if (!rows_current) evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  rows_current = false;
   bool approaching = false;
   for (const auto& r : u.rows) {
     if (r.joint || !cdata_->isActive(r.c)) continue;

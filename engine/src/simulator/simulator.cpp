@@ -47,6 +47,9 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   // Size every per-step buffer of the field and the solver once, here.
   std::string ignored;
   evaluateEndState(ignored);
+  if (uni_)  // each contact starts on its nearest piece
+    for (auto& r : uni_->rows)
+      if (!r.joint) r.feature = r.feature_start = r.feature_free = cdata_->blocks[r.c].feature;
   VecX vdot(model_.nv);
   (*field_)(t_, q_, v_, vdot);
   field_->clear();
@@ -72,15 +75,20 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   work_ = work_prev_ = {};
   if (uni_ && options_.contacts.enabled) {
     // A new state: unilateral constraints with clearance start open, the
-    // touching ones get their modes decided (impact, then forces).
+    // touching ones get their modes decided (impact, then forces), each on
+    // its nearest piece.
+    for (auto& r : uni_->rows) cdata_->setActive(r.c, false);
+    applyLatches();
     evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     for (auto& r : uni_->rows) {
       r.lifting = r.touching_down = false;
+      r.feature = r.feature_start = r.feature_free = r.joint ? -1 : cdata_->blocks[r.c].feature;
       cdata_->setActive(r.c, cdata_->gap[r.global] <= options_.contacts.gap_tol);
     }
     if (!decideModes(state_error_) || !frictionPhase(state_error_))
       state_error_ = "initial contact modes: " + state_error_;
     for (auto& r : uni_->rows) r.dir_start = r.dir;
+    applyLatches();
     integrator_->reset();
   }
   std::string error;
@@ -219,8 +227,17 @@ StepStatus Simulator::attemptStep(double h) {
     return fail(st, "the integrator produced a non-finite state");
   bool rows_current = false;  // cdata_ holds the rows at (t_, q_): the projection need not redo them
   if (uni_ && options_.contacts.enabled) {
+    // A closed contact that moved onto another piece of a terrain inside
+    // the step: an event, located (simulator/contact_features.cpp).
+    const int k = searchFeatures();
+    if (k >= 0) {
+      st = locateAndHandleEvent(st, st.h_taken, k, detail::Crossing::Feature);
+      if (st.ok) ++counters_.steps;
+      return st;
+    }
+    rows_current = searchedRowsLatched();
     std::string error;
-    if (!featureSwitchImpact(error, rows_current))
+    if (!pointJumpImpact(error, rows_current))
       return fail(st, "at t = " + std::to_string(t_) + ": " + error);
   }
 
@@ -264,6 +281,7 @@ StepStatus Simulator::attemptStep(double h) {
     st = locateAndHandleEvent(st, st.h_taken);
     if (!st.ok) return st;
   } else if (uni_) {
+    if (options_.contacts.enabled) acceptFeatures();
     uni_->zero_events = 0;
     for (auto& row : uni_->rows) row.dir_start = row.dir;  // the next step's slip reference
     st.events = static_cast<int>(events_.size());  // a slip at an over-constrained redo

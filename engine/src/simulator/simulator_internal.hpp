@@ -60,6 +60,10 @@ struct UnilateralRow {
   // force is an unknown of this solve, `settle_force` its first index.
   bool settling = false;
   int settle_force = 0;
+  // Piecewise supports (contact_features.cpp): the piece a closed contact's
+  // rows use between events (RowBlock::latched_feature), the nearest piece at
+  // the step's start, and the nearest one at the state last searched.
+  int feature = -1, feature_start = -1, feature_free = -1;
 };
 
 /// The friction forces of a set of contacts as the unknowns of one problem
@@ -116,7 +120,7 @@ struct FrictionProblem {
 };
 
 /// What a unilateral constraint's crossing is (the event function located).
-enum class Crossing { None, Gap, Normal, Cone, Slip };
+enum class Crossing { None, Gap, Normal, Cone, Slip, Feature };
 
 struct UnilateralState {
   std::vector<UnilateralRow> rows;
@@ -151,6 +155,7 @@ struct UnilateralState {
   // free slip acceleration in W's null space.
   MatX over_W;
   VecX over_g;
+  std::vector<int> feature_ahead;  // per row: its nearest piece feature_window after an event
   Eigen::SelfAdjointEigenSolver<MatX> over_eig;
 };
 

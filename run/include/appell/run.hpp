@@ -123,6 +123,9 @@ struct RunEvent {
   double normal_impulse = 0, tangential_impulse = 0;
   /// The impulse left the friction cone (|Λ_t| > μ Λ_n): a real contact would slip.
   bool outside_friction_cone = false;
+  /// A change of terrain piece (ContactEventKind::Feature): the piece it
+  /// moved onto, named (terrainFeatureName).
+  std::string piece;
 };
 
 struct RunSummary {

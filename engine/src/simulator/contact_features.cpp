@@ -1,0 +1,114 @@
+// Contacts on piecewise supports: a terrain's flat regions, edges and
+// vertices (contacts/include/appell/terrain.hpp).
+//
+// The nearest piece of a terrain changes where a wheel passes from a face to
+// an edge, from an edge to the next face, or where a rising face overtakes
+// the one it rolls on. There the normal's rate jumps (the surface's curvature
+// does), and at a concave crease the normal velocity jumps (an impact). Left
+// to each evaluation's nearest-piece search, such a switch falls between the
+// stages of a step; a rigid car whose two front wheels cross an edge a
+// round-off apart then sees one wheel on the face and the other on the edge,
+// and its redundant normal rows (four wheels, three heave/roll/pitch freedoms)
+// disagree by the jump in curvature: the step size collapses.
+//
+// So the piece is a mode, like open/closed and sticking/sliding (Pfeiffer &
+// Glocker 1996, ch. 5): between events every closed contact is evaluated on
+// its latched piece, extended past its bounds (RowBlock::latched_feature),
+// and the dynamics are smooth. After each step one search with the latches
+// off finds each contact's nearest piece; a closed contact whose nearest
+// piece is neither its latched one nor the one it had at the step's start has
+// switched, and the switch is an event located like a touchdown (bisection on
+// "some contact switched", on the dense output). At the event every contact
+// that switched takes its new piece, and so does every contact that switches
+// within `feature_window` after it (its lookahead piece): the car's two front
+// wheels change together. Then the modes are decided as at a touchdown — a
+// contact that now approaches its new piece takes an impact.
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_internal.hpp"
+
+namespace appell {
+
+using detail::UnilateralRow;
+
+/// Closed contacts use their latched piece; open ones search (their gap is
+/// the distance to the nearest piece, the touchdown's event function).
+void Simulator::applyLatches() {
+  for (const UnilateralRow& r : uni_->rows)
+    if (!r.joint)
+      cdata_->blocks[r.c].latched_feature = cdata_->isActive(r.c) ? r.feature : -1;
+}
+
+/// Whether closed row r has moved to a piece that is neither its latched one
+/// nor the one it had at the step's start (after searchFeatures).
+static bool switched(const UnilateralRow& r) {
+  return r.feature_free != r.feature && r.feature_free != r.feature_start;
+}
+
+/// Searches every contact's nearest piece at (t_, q_, v_) into feature_free
+/// (the rows in cdata_ are then the searched ones) and restores the latches.
+/// Returns the first closed row that switched, or −1.
+int Simulator::searchFeatures() {
+  auto& u = *uni_;
+  for (const UnilateralRow& r : u.rows)
+    if (!r.joint) cdata_->blocks[r.c].latched_feature = -1;
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  int first = -1;
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    UnilateralRow& r = u.rows[k];
+    if (r.joint) continue;
+    r.feature_free = cdata_->blocks[r.c].feature;
+    if (first < 0 && cdata_->isActive(r.c) && switched(r)) first = k;
+  }
+  applyLatches();
+  return first;
+}
+
+/// Whether the searched rows in cdata_ are every closed contact's latched
+/// ones (after searchFeatures): then they need no re-evaluation.
+bool Simulator::searchedRowsLatched() const {
+  for (const UnilateralRow& r : uni_->rows)
+    if (!r.joint && cdata_->isActive(r.c) && r.feature != r.feature_free) return false;
+  return true;
+}
+
+/// After a step with no switch: the pieces searched at its end are the next
+/// step's starting ones; an open contact follows its nearest piece.
+void Simulator::acceptFeatures() {
+  for (UnilateralRow& r : uni_->rows) {
+    if (r.joint) continue;
+    r.feature_start = r.feature_free;
+    if (!cdata_->isActive(r.c)) r.feature = r.feature_free;
+  }
+  applyLatches();
+}
+
+/// At an event (t_, q_, v_): every closed contact that switched — or, with
+/// `lookahead`, switches within feature_window (the pieces searched then are
+/// in feature_ahead) — takes its new piece (a Feature event each); an open
+/// one follows its nearest piece; the pieces now are the next step's
+/// starting ones.
+void Simulator::switchFeatures(bool lookahead) {
+  auto& u = *uni_;
+  searchFeatures();
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    UnilateralRow& r = u.rows[k];
+    if (r.joint) continue;
+    const int ahead = u.feature_ahead[k];
+    int next = r.feature;
+    if (!cdata_->isActive(r.c)) next = r.feature_free;
+    else if (switched(r)) next = r.feature_free;
+    else if (lookahead && ahead != r.feature && ahead != r.feature_start && ahead != r.feature_free)
+      next = ahead;
+    const bool logged = cdata_->isActive(r.c) && next != r.feature;
+    r.feature = next;
+    r.feature_start = r.feature_free;
+    if (logged) {
+      logEvent(ContactEventKind::Feature, k, 0, 0, 0);
+      events_.back().feature = next;
+    }
+  }
+  applyLatches();
+}
+
+}  // namespace appell
