@@ -9,9 +9,10 @@
 // of watching. Each loop restarts from the initial state every 200 steps so
 // both simulators see the same states.
 //
-// BM_EventStep/rimless_wheel: the cost of a step that holds an event
-// (location on the dense output, the step to it, impact and force problems)
-// against an ordinary step of the same scene: counter `event_over_step`.
+// BM_EventStep/<scene>: the cost of a step that holds an event (location on
+// the dense output, the step to it, impact and force problems) against an
+// ordinary step of the same scene: counter `event_over_step`. Scenes: the
+// rimless wheel, and the rigid car over a bump mesh (examples/car_bump).
 #include <appell/run.hpp>
 #include <appell/urdf.hpp>
 
@@ -26,7 +27,8 @@ using namespace appell;
 using Clock = std::chrono::steady_clock;
 
 const char* const kExamples[] = {"rolling_disk/rolling_disk.urdf", "diff_drive/diff_drive.urdf",
-                                 "car/car.urdf", "ball_turntable/ball_turntable.urdf"};
+                                 "car/car.urdf", "ball_turntable/ball_turntable.urdf",
+                                 "car_bump/car_bump.urdf"};
 
 std::string examplePath(const char* rel) { return std::string(APPELL_SOURCE_DIR) + "/examples/" + rel; }
 
@@ -74,10 +76,21 @@ void BM_EventCheckOverhead(benchmark::State& st) {
   st.counters["unilateral_over_bilateral"] = t_on / t_off;
   st.SetLabel(kExamples[st.range(0)]);
 }
-BENCHMARK(BM_EventCheckOverhead)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_EventCheckOverhead)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
+
+// The scenes with events, and how long to run each: the rimless wheel (one
+// impact at t ≈ 0.21 s); the car over the bump (its tyres' changes of
+// terrain piece, impacts at the ramps' feet, lift-offs at the top edges).
+struct EventScene {
+  const char* path;
+  double duration;
+};
+const EventScene kEventScenes[] = {{"rimless_wheel/rimless_wheel.urdf", 0.6},
+                                   {"car_bump/car_bump.urdf", 2.0}};
 
 void BM_EventStep(benchmark::State& st) {
-  const Scene scene = loadScene(examplePath("rimless_wheel/rimless_wheel.urdf"));
+  const EventScene& which = kEventScenes[st.range(0)];
+  const Scene scene = loadScene(examplePath(which.path));
   IntegratorOptions iopt;
   iopt.rtol = 1e-10;
   iopt.atol = 1e-12;
@@ -88,7 +101,7 @@ void BM_EventStep(benchmark::State& st) {
   long n_event = 0, n_plain = 0;
   for (auto _ : st) {
     sim->setState(0, scene.q0, scene.v0);
-    while (sim->time() < 0.6) {  // one impact at t ≈ 0.21 s
+    while (sim->time() < which.duration) {
       const auto t0 = Clock::now();
       const StepStatus s = sim->step(1e-2);
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -107,8 +120,9 @@ void BM_EventStep(benchmark::State& st) {
   }
   st.counters["event_over_step"] = (t_event / n_event) / (t_plain / n_plain);
   st.counters["events_per_run"] = static_cast<double>(n_event) / st.iterations();
+  st.SetLabel(which.path);
 }
-BENCHMARK(BM_EventStep)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EventStep)->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

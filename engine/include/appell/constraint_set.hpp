@@ -48,6 +48,12 @@ struct ConstraintData {
   /// holds zero rows for them, projections and residuals skip them. Only
   /// unilateral constraints open (the simulator's active set, contact_events).
   std::vector<char> active;
+  /// Set by a caller that needs only the closed rows (the dynamics at an
+  /// integrator's stage): open constraints are not evaluated at all — a
+  /// contact in flight costs nothing inside a step; its block keeps the gap
+  /// and frame of its last evaluation (the simulator's step end, where
+  /// touchdown is detected).
+  bool closed_only = false;
   int m_active = 0;                ///< rows of the closed constraints (sliding: the normal row)
   bool isActive(int constraint) const { return active[constraint] != 0; }
   /// Opens or closes a constraint (keeps m_active); no allocation.

@@ -208,6 +208,7 @@ class Simulator {
   bool projectAfterModes(std::string& error);
   bool impactPhase(std::string& error);
   bool forcePhase(std::string& error);
+  int unloadingContact();
   void saveCandidateRows();
   double rowVelocity(int u) const;
   double rowAcceleration(int u) const;

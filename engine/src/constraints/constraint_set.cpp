@@ -78,6 +78,7 @@ void evaluateConstraintRows(const Model& model, Data& data, const ConstraintList
   for (size_t k = 0; k < constraints.size(); ++k) {
     const Constraint& c = *constraints[k];
     RowBlock& blk = cd.blocks[k];
+    if (cd.closed_only && !cd.isActive(static_cast<int>(k))) continue;  // (its rows are zero)
     blk.singular = false;
     c.evaluate(model, data, t, q, v, blk);
     // An open contact's rows are not used: its singular geometry (a flat disk

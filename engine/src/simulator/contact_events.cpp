@@ -615,8 +615,18 @@ bool Simulator::forcePhase(std::string& error) {
     tau_.setZero();
     if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
     if (!solveDynamics(t_, q_, v_, tau_, u.res)) {
-      error = "contact modes: " + u.res.error;
-      return false;
+      // No acceleration holds every contact of the trial set: a rigid body
+      // on more contacts than its surface allows — a car whose tyres meet a
+      // ramp askew (the wobbly table). One of them unloads: the first whose
+      // opening leaves a consistent set that it separates from (γ̇ ≥ 0) and
+      // no contact pulls.
+      const int drop = unloadingContact();
+      if (drop < 0) {
+        error = "contact modes: " + u.res.error;
+        return false;
+      }
+      u.rows[drop].in_set = false;
+      continue;
     }
     u.vdot = u.res.vdot;
     forwardKinematics(model_, *data_, q_, v_, u.vdot);
@@ -707,6 +717,44 @@ bool Simulator::frictionPhase(std::string& error, int forced) {
     }
     if (change < 0) return true;
   }
+}
+
+/// In the force phase, when the trial set is inconsistent: the in-set
+/// contact whose opening gives a consistent set where it separates and every
+/// other in-set contact pushes — of those, the one that separates fastest —
+/// or −1. Only a real inconsistency unloads a contact: the separation must
+/// exceed kUnloadAcceleration of the state's accelerations, or a residual
+/// that drift leaves (a state projected to 1e-6) would open a loaded tyre;
+/// that stays an error. One solve per candidate; the active set is left as
+/// the trial set.
+int Simulator::unloadingContact() {
+  constexpr double kUnloadAcceleration = 1e-4;
+  auto& u = *uni_;
+  const double ftol = options_.contacts.force_tol;
+  int found = -1;
+  double fastest = 0;
+  for (int j = 0; j < static_cast<int>(u.rows.size()); ++j) {
+    UnilateralRow& cand = u.rows[j];
+    if (!cand.touching || !cand.in_set) continue;
+    cdata_->setActive(cand.c, false);
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    if (solveDynamics(t_, q_, v_, tau_, u.res)) {
+      u.vdot = u.res.vdot;
+      forwardKinematics(model_, *data_, q_, v_, u.vdot);
+      const double fscale = std::max(1.0, u.res.lambda.lpNorm<Eigen::Infinity>());
+      const double ascale = std::max(1.0, u.res.vdot.lpNorm<Eigen::Infinity>());
+      const double separation = rowAcceleration(j);
+      bool ok = separation >= kUnloadAcceleration * ascale && separation > fastest;
+      for (const UnilateralRow& r : u.rows)
+        ok = ok && !(r.touching && r.in_set && r.c != cand.c && u.res.lambda[r.global] < -ftol * fscale);
+      if (ok) {
+        found = j;
+        fastest = separation;
+      }
+    }
+    cdata_->setActive(cand.c, true);
+  }
+  return found;
 }
 
 /// Decides the mode of every touching unilateral constraint at (t_, q_, v_):

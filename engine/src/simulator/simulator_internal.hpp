@@ -194,7 +194,11 @@ class Simulator::Field final : public AccelerationField {
         return false;
       }
     }
+    // Only the closed rows act on the motion: contacts in flight are
+    // evaluated at the step's end, where touchdown is detected.
+    s.cdata_->closed_only = true;
     evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
+    s.cdata_->closed_only = false;
     if (s.options_.baumgarte.enabled)
       applyBaumgarte(*s.data_, s.constraints_, *s.cdata_, v, s.options_.baumgarte.alpha,
                      s.options_.baumgarte.beta);
