@@ -497,6 +497,7 @@ bool Simulator::impactPhase(std::string& error) {
     r.in_set = r.was_closed || r.gamma < -o.speed_tol;
   }
   if (!any) return true;
+  int last_flip = -1, next_unload = 0;
   for (int it = 0;; ++it) {
     if (it == o.max_mode_iterations) {
       error = "impact: no consistent set of contacts after " + std::to_string(it) + " pivots";
@@ -529,7 +530,27 @@ bool Simulator::impactPhase(std::string& error) {
     }
     if (flip < 0) break;
     std::swap(v_, u.vplus);  // back to the pre-impact velocity
+    if (flip == last_flip) {
+      // A contact that neither holds (its impulse would pull) nor stays out
+      // (it keeps approaching): the set around it is wrong — a rigid body
+      // on more contacts than its surface allows (a car on uneven ground).
+      // Keep it and unload the other set members in turn.
+      int other = -1;
+      for (int k = next_unload; k < static_cast<int>(u.rows.size()) && other < 0; ++k)
+        if (k != flip && u.rows[k].touching && u.rows[k].in_set) other = k;
+      if (other < 0) {
+        error = "impact: no consistent set of contacts: '" + constraints_[u.rows[flip].c]->name() +
+                "' would pull and cannot stay out";
+        return false;
+      }
+      u.rows[other].in_set = false;
+      u.rows[flip].in_set = true;
+      next_unload = other + 1;
+      last_flip = -1;
+      continue;
+    }
     u.rows[flip].in_set = !u.rows[flip].in_set;
+    last_flip = flip;
   }
   // (u.vplus holds v⁻.)
   if (!frictionImpact(error)) return false;
@@ -586,6 +607,7 @@ bool Simulator::forcePhase(std::string& error) {
   }
   if (!any) return true;
   u.vminus = v_;
+  int last_flip = -1, next_unload = 0;
   for (int it = 0;; ++it) {
     if (it == o.max_mode_iterations) {
       error = "contact modes: no consistent set of contacts after " + std::to_string(it) +
@@ -645,7 +667,26 @@ bool Simulator::forcePhase(std::string& error) {
         flip = k;
     }
     if (flip < 0) break;
+    if (flip == last_flip) {
+      // It neither pushes in the set nor separates out of it: unload the
+      // other set members in turn (as in impactPhase).
+      int other = -1;
+      for (int k = next_unload; k < static_cast<int>(u.rows.size()) && other < 0; ++k)
+        if (k != flip && u.rows[k].touching && u.rows[k].in_set) other = k;
+      if (other < 0) {
+        error = "contact modes: no consistent set of contacts: '" +
+                constraints_[u.rows[flip].c]->name() +
+                "' would pull and cannot separate (a Painlevé-type configuration?)";
+        return false;
+      }
+      u.rows[other].in_set = false;
+      u.rows[flip].in_set = true;
+      next_unload = other + 1;
+      last_flip = -1;
+      continue;
+    }
     u.rows[flip].in_set = !u.rows[flip].in_set;
+    last_flip = flip;
   }
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
     const auto& r = u.rows[k];
