@@ -111,6 +111,27 @@ void Simulator::setUpUnilateral() {
   u.feature_ahead.assign(u.rows.size(), -1);
 }
 
+namespace {
+
+/// A pivoting's two-cycle: contact `flip` was flipped straight back — in the
+/// set its multiplier pulls, out of it it moves into its support. The set
+/// around it is wrong (a rigid body on more contacts than its surface
+/// allows: a car on uneven ground): keep it and unload the other set
+/// members in turn, from `next_unload`. False when none is left.
+bool breakTwoCycle(std::vector<UnilateralRow>& rows, int flip, int& last_flip, int& next_unload) {
+  int other = -1;
+  for (int k = next_unload; k < static_cast<int>(rows.size()) && other < 0; ++k)
+    if (k != flip && rows[k].touching && rows[k].in_set) other = k;
+  if (other < 0) return false;
+  rows[other].in_set = false;
+  rows[flip].in_set = true;
+  next_unload = other + 1;
+  last_flip = -1;
+  return true;
+}
+
+}  // namespace
+
 // ---------------------------------------------------------------- detection
 
 /// The first unilateral constraint whose event function changed sign over
@@ -530,23 +551,12 @@ bool Simulator::impactPhase(std::string& error) {
     }
     if (flip < 0) break;
     std::swap(v_, u.vplus);  // back to the pre-impact velocity
-    if (flip == last_flip) {
-      // A contact that neither holds (its impulse would pull) nor stays out
-      // (it keeps approaching): the set around it is wrong — a rigid body
-      // on more contacts than its surface allows (a car on uneven ground).
-      // Keep it and unload the other set members in turn.
-      int other = -1;
-      for (int k = next_unload; k < static_cast<int>(u.rows.size()) && other < 0; ++k)
-        if (k != flip && u.rows[k].touching && u.rows[k].in_set) other = k;
-      if (other < 0) {
+    if (flip == last_flip) {  // it would pull, and out of the set it approaches
+      if (!breakTwoCycle(u.rows, flip, last_flip, next_unload)) {
         error = "impact: no consistent set of contacts: '" + constraints_[u.rows[flip].c]->name() +
                 "' would pull and cannot stay out";
         return false;
       }
-      u.rows[other].in_set = false;
-      u.rows[flip].in_set = true;
-      next_unload = other + 1;
-      last_flip = -1;
       continue;
     }
     u.rows[flip].in_set = !u.rows[flip].in_set;
@@ -667,22 +677,13 @@ bool Simulator::forcePhase(std::string& error) {
         flip = k;
     }
     if (flip < 0) break;
-    if (flip == last_flip) {
-      // It neither pushes in the set nor separates out of it: unload the
-      // other set members in turn (as in impactPhase).
-      int other = -1;
-      for (int k = next_unload; k < static_cast<int>(u.rows.size()) && other < 0; ++k)
-        if (k != flip && u.rows[k].touching && u.rows[k].in_set) other = k;
-      if (other < 0) {
+    if (flip == last_flip) {  // it would pull, and out of the set it accelerates into its support
+      if (!breakTwoCycle(u.rows, flip, last_flip, next_unload)) {
         error = "contact modes: no consistent set of contacts: '" +
                 constraints_[u.rows[flip].c]->name() +
                 "' would pull and cannot separate (a Painlevé-type configuration?)";
         return false;
       }
-      u.rows[other].in_set = false;
-      u.rows[flip].in_set = true;
-      next_unload = other + 1;
-      last_flip = -1;
       continue;
     }
     u.rows[flip].in_set = !u.rows[flip].in_set;
