@@ -315,7 +315,9 @@ TEST(ContactTerrain, BallPivotsAboutTheCreaseAndLiftsOffWhereTheoryPredicts) {
     ASSERT_EQ(pieces.size(), v0 > 0.9 ? 1u : 2u);
     EXPECT_NEAR(pieces[0].t, 0.2 / v0, 1e-11) << "onto the edge";
     EXPECT_NEAR(run.at_event[0], 0, 1e-11);
-    if (v0 < 0.9) EXPECT_NEAR(run.at_event.back(), kSlope, 1e-8) << "onto the ramp";
+    if (v0 < 0.9) {
+      EXPECT_NEAR(run.at_event.back(), kSlope, 1e-8) << "onto the ramp";
+    }
   }
 }
 
