@@ -268,11 +268,12 @@ window.addEventListener('resize', () => {
   render();
 });
 // ---- contact events on the time line: a tick per event time (touchdown
-// green, bounce blue, lift-off red, slip orange, stick purple); clicking one
-// shows that instant.
+// green, bounce blue, lift-off red, slip orange, stick purple, a change of
+// terrain piece grey); clicking one shows that instant.
 {
   const marks = document.getElementById('marks'),
-    colour = { touchdown: '#2a9d2a', bounce: '#3a7dc9', lift_off: '#c0392b', slip: '#e08a00', stick: '#8e5bb5' };
+    colour = { touchdown: '#2a9d2a', bounce: '#3a7dc9', lift_off: '#c0392b', slip: '#e08a00', stick: '#8e5bb5',
+      feature: '#8a8a8a' };
   const byTime = new Map();
   for (const [te, c, kind] of data.events) {
     if (!byTime.has(te)) byTime.set(te, []);
