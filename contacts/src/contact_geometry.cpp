@@ -45,7 +45,8 @@ void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out) {
 void contactGeometry(const Shape& shape, const SupportSurface& surface,
                      const SupportState& support, const SE3& body_pose,
                      const Vec6& body_velocity, ContactGeometry& out,
-                     const GeometryOptions& options, int latched_feature) {
+                     const GeometryOptions& options, int latched_feature,
+                     std::span<const int> excluded) {
   out.singular = false;
   out.reason = nullptr;
   out.margin = 1;
@@ -66,7 +67,7 @@ void contactGeometry(const Shape& shape, const SupportSurface& surface,
                  },
                  [&](const TerrainMesh& t) {
                    detail::terrainGeometry(shape, t, support, body_pose, body_velocity, out,
-                                           options, latched_feature);
+                                           options, latched_feature, excluded);
                  }},
              surface);
 }

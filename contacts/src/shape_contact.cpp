@@ -79,6 +79,14 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
     fail("a support carried by a body moves with it: give a StaticMotion (its pose on the body)");
   if (!(spec_.mu >= 0))
     fail("the friction coefficient μ must be ≥ 0 (∞: no limit)");
+  if (!(spec_.points >= 1 && spec_.points <= 4))
+    fail("'points' must be 1 … 4 (places the body may touch a terrain at once), got " +
+         std::to_string(spec_.points));
+  if (spec_.points > 1 && !std::holds_alternative<TerrainMesh>(support.surface))
+    fail("more than one point needs a terrain support: a smooth body touches a plane or a "
+         "sphere at one point");
+  if (spec_.points > 1 && !spec_.unilateral)
+    fail("more than one point needs a unilateral contact (the points make and break)");
   if (!(spec_.restitution >= 0 && spec_.restitution <= 1))
     fail("the restitution must lie in [0, 1] (0: plastic, 1: elastic), got " +
          std::to_string(spec_.restitution));
@@ -203,7 +211,8 @@ void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
                              const SupportState& S, RowBlock& out) const {
   ContactGeometry g;
   contactGeometry(spec_.shape, spec_.support.surface, S, body_pose, body_velocity, g,
-                  spec_.options.geometry, out.latched_feature);
+                  spec_.options.geometry, out.latched_feature,
+                  std::span<const int>(out.excluded_features.data(), out.excluded_count));
   out.feature = g.feature;
   out.m = rows_;
   out.Wa.resize(rows_, 6);
@@ -271,7 +280,29 @@ void ShapeContact::evaluate(const Model&, const Data& data, double t, const VecX
 }
 
 std::shared_ptr<ShapeContact> makeContact(const ContactSpec& spec) {
-  return std::make_shared<ShapeContact>(spec);
+  auto c = std::make_shared<ShapeContact>(spec);
+  if (spec.points > 1)
+    throw std::invalid_argument("contact '" + c->name() + "': " + std::to_string(spec.points) +
+                                " points make " + std::to_string(spec.points) +
+                                " contacts (makeContactPoints)");
+  return c;
+}
+
+std::vector<std::shared_ptr<ShapeContact>> makeContactPoints(const ContactSpec& spec) {
+  auto first = std::make_shared<ShapeContact>(spec);  // validates, names, builds the index
+  if (spec.points == 1) return {first};
+  const ContactSpec pair = first->spec();
+  auto group = std::make_shared<const ContactSpec>(pair);
+  std::vector<std::shared_ptr<ShapeContact>> points;
+  for (int k = 0; k < pair.points; ++k) {
+    ContactSpec one = pair;
+    one.options.name = pair.options.name + "/p" + std::to_string(k);
+    auto c = std::make_shared<ShapeContact>(std::move(one));
+    c->group_ = group;
+    c->slot_ = k;
+    points.push_back(std::move(c));
+  }
+  return points;
 }
 
 std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,

@@ -133,6 +133,41 @@ TerrainMesh makeTerrain(std::vector<Vec3> vertices, std::vector<std::array<int, 
   }
   idx->regions = static_cast<int>(idx->region_face.size());
   idx->edges = static_cast<int>(idx->edge_ends.size());
+  // Each edge's faces, and each welded vertex's edges (compressed rows).
+  idx->edge_face.assign(idx->edges, {-1, -1});
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      auto& ef = idx->edge_face[idx->edge[f][k]];
+      if (ef[0] < 0) ef[0] = f;
+      else if (ef[1] < 0 && ef[0] != f) ef[1] = f;
+    }
+  const int nv = static_cast<int>(t.vertices.size());
+  idx->edge_normal.assign(idx->edges, Vec3::Zero());
+  for (int e = 0; e < idx->edges; ++e)
+    for (int f : idx->edge_face[e])
+      if (f >= 0) idx->edge_normal[e] += idx->normal[f];
+  idx->vertex_normal.assign(nv, Vec3::Zero());
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto& tri = t.triangles[f];
+      const Vec3& x = t.vertices[tri[k]];
+      const Vec3 a = (t.vertices[tri[(k + 1) % 3]] - x).normalized();
+      const Vec3 b = (t.vertices[tri[(k + 2) % 3]] - x).normalized();
+      idx->vertex_normal[weld[tri[k]]] += std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * idx->normal[f];
+    }
+  for (Vec3& n : idx->edge_normal) n.normalize();
+  for (Vec3& n : idx->vertex_normal)
+    if (n.norm() > 0) n.normalize();
+  idx->vertex_edge_start.assign(nv + 1, 0);
+  for (const auto& ends : idx->edge_ends)
+    for (int v : ends) ++idx->vertex_edge_start[v + 1];
+  for (int v = 0; v < nv; ++v) idx->vertex_edge_start[v + 1] += idx->vertex_edge_start[v];
+  idx->vertex_edge.assign(idx->vertex_edge_start[nv], -1);
+  {
+    std::vector<int> fill(idx->vertex_edge_start.begin(), idx->vertex_edge_start.end() - 1);
+    for (int e = 0; e < idx->edges; ++e)
+      for (int v : idx->edge_ends[e]) idx->vertex_edge[fill[v]++] = e;
+  }
   idx->weld = std::move(weld);
   idx->bvh = detail::buildHierarchy(t.vertices, t.triangles, true);
   if (!idx->bvh) fail("FCL could not build its bounding-volume hierarchy");

@@ -126,4 +126,44 @@ bool terrainVertexGeometry(const Shape& shape, const Vec3& x_s, const SupportSta
   return !out.singular;
 }
 
+bool separatePiece(const TerrainMesh& t, int feature, const Vec3& n) {
+  const TerrainIndex& idx = *t.index;
+  // How far past a face's plane the normal must lean (rad): on an edge
+  // inside a flat region, or at a face's boundary, n lies in the plane.
+  constexpr double kLean = 1e-9;
+  if (feature < idx.regions) return true;
+  if (feature < idx.regions + idx.edges) {
+    const int e = feature - idx.regions;
+    const Vec3& a = t.vertices[idx.edge_ends[e][0]];
+    const Vec3 dir = t.vertices[idx.edge_ends[e][1]] - a;
+    for (int f : idx.edge_face[e]) {
+      if (f < 0) continue;
+      int k = 0;
+      while (k < 2 && idx.edge[f][k] != e) ++k;
+      Vec3 u = idx.normal[f].cross(dir).normalized();
+      if (u.dot(t.vertices[t.triangles[f][k]] - a) < 0) u = -u;  // into the face
+      if (!(n.dot(u) < -kLean)) return false;
+    }
+    return true;
+  }
+  const int v = feature - idx.regions - idx.edges;
+  for (int i = idx.vertex_edge_start[v]; i < idx.vertex_edge_start[v + 1]; ++i) {
+    const auto& ends = idx.edge_ends[idx.vertex_edge[i]];
+    const Vec3 d = t.vertices[ends[0] == v ? ends[1] : ends[0]] - t.vertices[v];
+    if (!(n.dot(d) < -kLean * d.norm())) return false;
+  }
+  return true;
+}
+
+void noPieceInReach(const SupportState& S, const SE3& pose, double reach, ContactGeometry& out) {
+  out = ContactGeometry{};
+  out.normal = S.pose.R.col(2);
+  out.t1 = S.pose.R.col(0);
+  out.t2 = S.pose.R.col(1);
+  out.gap = reach;
+  out.point = pose.p;
+  out.support_point = pose.p - reach * out.normal;
+  out.feature = -1;
+}
+
 }  // namespace appell::detail

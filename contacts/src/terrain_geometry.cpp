@@ -26,9 +26,6 @@ Vec3 barycentric(const TerrainMesh& t, const TerrainIndex& idx, int f, const Vec
 }
 
 constexpr double kInsideTol = 1e-12;
-/// Depth below which an edge or vertex contact is accepted (m): the drift the
-/// projection leaves is orders of magnitude smaller.
-constexpr double kFeatureDepth = 1e-6;
 /// How much nearer than a holding face an edge or vertex must be (m).
 constexpr double kFaceMargin = 1e-12;
 
@@ -97,31 +94,22 @@ void latchedGeometry(const Shape& shape, const TerrainMesh& t, int feature, cons
   out.feature = feature;
 }
 
-}  // namespace
+// Whether an edge or vertex contact's normal n (support frame) leaves the
+// surface on its outer side (its pseudonormal's, TerrainIndex): a body that
+// has passed through an edge in one step of free flight is nearest to it
+// from behind, where it is no contact (the faces' planes give its negative
+// gap there).
+bool frontSide(const TerrainIndex& idx, int piece, const Vec3& n) {
+  if (piece < idx.regions) return true;
+  if (piece < idx.regions + idx.edges) return n.dot(idx.edge_normal[piece - idx.regions]) > 0;
+  return n.dot(idx.vertex_normal[piece - idx.regions - idx.edges]) > 0;
+}
 
-void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const SupportState& S,
-                     const SE3& pose, const Vec6& V, ContactGeometry& out,
-                     const GeometryOptions& opt, int latched) {
-  if (!terrain.index) {
-    out = ContactGeometry{};
-    markSingular(out, "terrain index not built (create the mesh with makeTerrain)");
-    return;
-  }
-  const TerrainIndex& idx = *terrain.index;
-  if (const auto* sphere = std::get_if<Sphere>(&shape)) {
-    terrainSphereGeometry(*sphere, terrain, S, pose, V, out, opt, latched);
-    return;
-  }
-  if (latched >= 0) {
-    latchedGeometry(shape, terrain, latched, S, pose, V, out, opt);
-    return;
-  }
-
-  // Box of the body in the support frame from its extreme points along the
-  // support axes, grown by half its largest side: every face whose plane
-  // contact lies within that margin of the body overlaps it.
+// Box of the body in the support frame from its extreme points along the
+// support axes, and half its largest side.
+double bodyBox(const Shape& shape, const SupportState& S, const SE3& pose,
+               const GeometryOptions& opt, Vec3& lo, Vec3& hi) {
   const SE3 inv = S.pose.inverse();
-  Vec3 lo, hi;
   for (int i = 0; i < 3; ++i) {
     for (int s = -1; s <= 1; s += 2) {
       const Vec3 d = S.pose.R.col(i) * static_cast<double>(s);
@@ -131,7 +119,101 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
       else hi(i) = x;
     }
   }
-  const double margin = 0.5 * (hi - lo).maxCoeff() + 1e-9;
+  return 0.5 * (hi - lo).maxCoeff() + 1e-9;
+}
+
+// Another point of a pair whose other points hold `excluded`: the nearest
+// separate piece (separatePiece) not among them whose gap is within the
+// margin of the body box (half the body's largest side), else that margin
+// as the gap. One query of the box grown by the margin holds every such
+// piece (a face with gap g meets the box grown by |g|).
+void separateGeometry(const Shape& shape, const TerrainMesh& t, const SupportState& S,
+                      const SE3& pose, const Vec6& V, ContactGeometry& out,
+                      const GeometryOptions& opt, std::span<const int> excluded) {
+  const TerrainIndex& idx = *t.index;
+  Vec3 lo, hi;
+  const double margin = bodyBox(shape, S, pose, opt, lo, hi);
+  lo.array() -= margin;
+  hi.array() += margin;
+  const SE3 inv = S.pose.inverse();
+  const Vec3 c_s = inv.apply(pose.apply(shapeCentre(shape)));
+  const double bound = boundingRadius(shape);
+  double best_gap = margin;
+  int best = -1;
+  ContactGeometry trial;
+  auto take = [&](int piece) {
+    const Vec3 n = S.pose.R.transpose() * trial.normal;
+    if (!(trial.gap < best_gap) || excludedPiece(excluded, piece) ||
+        !frontSide(idx, piece, n) || !separatePiece(t, piece, n))
+      return;
+    best = piece;
+    best_gap = trial.gap;
+    out = trial;
+  };
+  forEachFaceInBox(idx, lo, hi, [&](int f) {
+    const auto& tri = t.triangles[f];
+    Plane plane;
+    plane.point = t.vertices[tri[0]];
+    plane.normal = idx.normal[f];
+    trial.singular = false;
+    trial.reason = nullptr;
+    planeGeometry(shape, plane, S, pose, V, trial, opt);
+    if (barycentric(t, idx, f, inv.apply(trial.support_point)).minCoeff() >= -kInsideTol) {
+      take(idx.regionFeature(f));
+      return;
+    }
+    // Its edges and vertices, when the triangle can be nearer than the best.
+    const double reach =
+        (c_s - nearestPointOnTriangle(c_s, t.vertices[tri[0]], t.vertices[tri[1]],
+                                      t.vertices[tri[2]]))
+            .norm() -
+        bound;
+    if (!(trial.gap < best_gap) || !(reach < best_gap)) return;
+    for (int k = 0; k < 3; ++k) {
+      const auto& ends = idx.edge_ends[idx.edge[f][k]];
+      if (terrainEdgeGeometry(shape, t.vertices[ends[0]], t.vertices[ends[1]], S, pose, V, trial,
+                              opt))
+        take(idx.edgeFeature(f, k));
+      if (terrainVertexGeometry(shape, t.vertices[idx.weld[tri[k]]], S, pose, V, trial, opt))
+        take(idx.vertexFeature(tri[k]));
+    }
+  });
+  if (best < 0) {
+    noPieceInReach(S, pose, margin, out);
+    return;
+  }
+  out.feature = best;
+}
+
+}  // namespace
+
+void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const SupportState& S,
+                     const SE3& pose, const Vec6& V, ContactGeometry& out,
+                     const GeometryOptions& opt, int latched, std::span<const int> excluded) {
+  if (!terrain.index) {
+    out = ContactGeometry{};
+    markSingular(out, "terrain index not built (create the mesh with makeTerrain)");
+    return;
+  }
+  const TerrainIndex& idx = *terrain.index;
+  if (const auto* sphere = std::get_if<Sphere>(&shape)) {
+    terrainSphereGeometry(*sphere, terrain, S, pose, V, out, opt, latched, excluded);
+    return;
+  }
+  if (latched >= 0) {
+    latchedGeometry(shape, terrain, latched, S, pose, V, out, opt);
+    return;
+  }
+  if (!excluded.empty()) {
+    separateGeometry(shape, terrain, S, pose, V, out, opt, excluded);
+    return;
+  }
+
+  // The body's box grown by half its largest side: every face whose plane
+  // contact lies within that margin of the body overlaps it.
+  const SE3 inv = S.pose.inverse();
+  Vec3 lo, hi;
+  const double margin = bodyBox(shape, S, pose, opt, lo, hi);
   lo.array() -= margin;
   hi.array() += margin;
 
@@ -165,14 +247,16 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
     // vertices (over a crease or a corner). The face's plane gap bounds the
     // triangle's distance from below, so only a triangle whose plane is
     // nearer than the best contact so far is worth those solves. An edge or
-    // vertex is a distance, not a signed depth: one that the body has sunk
-    // past by more than drift (kFeatureDepth) says nothing about the contact.
+    // vertex counts from its outer side only (frontSide): a body that has
+    // passed through it is behind the surface, not touching it; from that
+    // side its gap is signed like a face's, so a body falling onto a ridge
+    // is seen sinking into it (the touchdown's event function).
     // Near a convex edge the edge's gap exceeds the face's by only
     // O(distance² / radius): an edge or vertex must beat a holding face by
     // more than round-off (kFaceMargin), or the piece flickers to the edge
     // before the contact point reaches it.
-    auto better = [&](const ContactGeometry& g) {
-      if (g.gap < -kFeatureDepth) return false;
+    auto better = [&](const ContactGeometry& g, int piece) {
+      if (!frontSide(idx, piece, S.pose.R.transpose() * g.normal)) return false;
       if (best < 0) return true;
       return g.gap < out.gap - (best_feature < idx.regions ? kFaceMargin : 0.0);
     };
@@ -191,14 +275,14 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
         const auto& ends = idx.edge_ends[idx.edge[f][k]];
         if (terrainEdgeGeometry(shape, terrain.vertices[ends[0]], terrain.vertices[ends[1]], S,
                                 pose, V, feature, opt) &&
-            better(feature)) {
+            better(feature, idx.edgeFeature(f, k))) {
           best = f;
           best_feature = idx.edgeFeature(f, k);
           out = feature;
         }
         if (terrainVertexGeometry(shape, terrain.vertices[idx.weld[tri[k]]], S, pose, V, feature,
                                   opt) &&
-            better(feature)) {
+            better(feature, idx.vertexFeature(tri[k]))) {
           best = f;
           best_feature = idx.vertexFeature(tri[k]);
           out = feature;

@@ -18,6 +18,8 @@
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/math/bv/OBBRSS.h>
 
+#include <span>
+
 namespace appell {
 
 struct TerrainIndex {
@@ -35,6 +37,15 @@ struct TerrainIndex {
   std::vector<std::array<int, 3>> edge;          ///< per face: the id of its edge k (opposite vertex k)
   std::vector<std::array<int, 2>> edge_ends;     ///< per edge: its two (welded) vertices
   std::vector<int> weld;                         ///< per vertex: the first vertex at its position
+  std::vector<std::array<int, 2>> edge_face;     ///< per edge: its (first two) faces, −1 if none
+  /// Angle-weighted pseudonormals of the edges and (welded) vertices: the
+  /// side of the surface a point nearest to them lies on is the sign of
+  /// (p − x)·N (Bærentzen & Aanæs, "Signed distance computation using the
+  /// angle weighted pseudonormal", IEEE TVCG 2005).
+  std::vector<Vec3> edge_normal, vertex_normal;
+  /// Per welded vertex v: its edges are vertex_edge[vertex_edge_start[v] …
+  /// vertex_edge_start[v + 1]) (a separate point's test, separatePiece).
+  std::vector<int> vertex_edge_start, vertex_edge;
   int regions = 0, edges = 0;
   int regionFeature(int f) const { return region[f]; }
   int edgeFeature(int f, int k) const { return regions + edge[f][k]; }
@@ -89,9 +100,14 @@ void forEachFaceInBox(const TerrainIndex& index, const Vec3& lo, const Vec3& hi,
 /// edge or vertex.
 /// `latched` ≥ 0: with that feature only (TerrainIndex numbers them),
 /// extended past its bounds.
+/// `excluded` non-empty (the pieces the other points of the same pair hold):
+/// the nearest separate piece (separatePiece) not among them within a reach
+/// of the body's size; when there is none, out.feature = −1 and out.gap =
+/// that reach (a lower bound of the gap, continuous as pieces come in reach).
 void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const SupportState& S,
                      const SE3& pose, const Vec6& V, ContactGeometry& out,
-                     const GeometryOptions& opt, int latched = -1);
+                     const GeometryOptions& opt, int latched = -1,
+                     std::span<const int> excluded = {});
 
 /// A sphere on a terrain: the contact at the mesh point nearest to its
 /// centre — on a face (the plane contact), an edge or a vertex — or at the
@@ -99,7 +115,31 @@ void terrainGeometry(const Shape& shape, const TerrainMesh& terrain, const Suppo
 /// (terrain_sphere.cpp).
 void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
-                           const GeometryOptions& opt, int latched);
+                           const GeometryOptions& opt, int latched,
+                           std::span<const int> excluded = {});
+
+/// No piece in reach of an excluded search: gap = reach, normal along the
+/// support's z axis, feature −1 (not singular: an open contact's watch).
+void noPieceInReach(const SupportState& S, const SE3& pose, double reach, ContactGeometry& out);
+
+/// Whether the piece `feature` is a separate place where the body touches
+/// or nears the terrain: the distance from the body to the surface has a
+/// local minimum on it, with n (support frame, from the piece toward the body)
+/// the contact normal there. A region always is (its face holds the point);
+/// an edge when n leans out of both its faces (n · u_f < −1e-9 for each face
+/// f, u_f the face's direction away from the edge in its plane); a vertex
+/// when n leans away from all its edges. An edge inside a flat region, a
+/// concave crease or a vertex inside a face never is (their nearest points
+/// are on a face). These are the Voronoi tests of the pieces (Ericson,
+/// Real-Time Collision Detection, 2005, §5.1.5) over the whole surface.
+bool separatePiece(const TerrainMesh& terrain, int feature, const Vec3& n);
+
+/// Whether `feature` is one of `excluded`.
+inline bool excludedPiece(std::span<const int> excluded, int feature) {
+  for (int e : excluded)
+    if (e == feature) return true;
+  return false;
+}
 
 /// A point of the shape to measure from (its centre; a pose origin for the
 /// collision-only shapes) and the radius of a ball about it holding the shape.

@@ -67,7 +67,8 @@ Vec3 nearestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 
 void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, const SupportState& S,
                            const SE3& pose, const Vec6& V, ContactGeometry& out,
-                           const GeometryOptions& opt, int latched) {
+                           const GeometryOptions& opt, int latched,
+                           std::span<const int> excluded) {
   const TerrainIndex& idx = *terrain.index;
   const Twist body(V), sup(S.V);
   const Vec3 c = pose.apply(sphere.centre);
@@ -78,7 +79,42 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
   // nearest over the mesh.
   int feature = latched;
   Vec3 xs = Vec3::Zero();
-  if (latched < 0) {
+  // The piece a triangle's nearest point lies on: on an edge or a vertex but
+  // along the face's normal (its boundary, or an edge between coplanar
+  // faces), the face's region.
+  auto pieceOf = [&](int f, const Nearest& nr) {
+    const Vec3 d = cs - nr.x;
+    const Vec3& nf = idx.normal[f];
+    const bool on_plane = nf.dot(d) >= 0 && (d - nf * nf.dot(d)).norm() <= 1e-12 * d.norm();
+    if (nr.feature == 0 || on_plane) return idx.regionFeature(f);
+    if (nr.feature <= 3) return idx.edgeFeature(f, nr.feature - 1);
+    return idx.vertexFeature(terrain.triangles[f][nr.feature - 4]);
+  };
+  if (latched < 0 && !excluded.empty()) {
+    // Another point of the pair (the others hold `excluded`): the nearest
+    // separate piece within 2ρ of the centre, else a gap of ρ.
+    const double reach = 2 * sphere.radius;
+    double best_d2 = reach * reach;
+    forEachFaceInBox(idx, cs.array() - reach, cs.array() + reach, [&](int f) {
+      const auto& tri = terrain.triangles[f];
+      const Nearest nr = nearestOnTriangle(cs, terrain.vertices[tri[0]], terrain.vertices[tri[1]],
+                                           terrain.vertices[tri[2]]);
+      const double d2 = (cs - nr.x).squaredNorm();
+      if (!(d2 < best_d2) || d2 == 0) return;
+      const int piece = pieceOf(f, nr);
+      if (excludedPiece(excluded, piece) ||
+          !separatePiece(terrain, piece, (cs - nr.x) / std::sqrt(d2)))
+        return;
+      best_d2 = d2;
+      feature = piece;
+      xs = nr.x;
+    });
+    if (feature < 0) {
+      noPieceInReach(S, pose, reach - sphere.radius, out);
+      return;
+    }
+    if (feature >= idx.regions + idx.edges) xs = terrain.vertices[feature - idx.regions - idx.edges];
+  } else if (latched < 0) {
     // Candidate faces: every triangle within distance r of the centre meets
     // the box cs ± r; r widens until the nearest point found lies within it.
     // Ties go to a face (a point on an edge or vertex inside a flat region
@@ -107,16 +143,7 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
           ((hi - (root.To + root_half)).array() >= 0).all())
         break;
     }
-    const int f = best.face;
-    const auto& tri = terrain.triangles[f];
-    // On an edge or a vertex but along the face's normal (its boundary, or
-    // an edge between coplanar faces): the face's plane contact.
-    const Vec3 d = cs - best.x;
-    const Vec3& nf = idx.normal[f];
-    const bool on_plane = nf.dot(d) >= 0 && (d - nf * nf.dot(d)).norm() <= 1e-12 * d.norm();
-    if (best.feature == 0 || on_plane) feature = idx.regionFeature(f);
-    else if (best.feature <= 3) feature = idx.edgeFeature(f, best.feature - 1);
-    else feature = idx.vertexFeature(tri[best.feature - 4]);
+    feature = pieceOf(best.face, best);
     if (feature >= idx.regions + idx.edges) xs = terrain.vertices[feature - idx.regions - idx.edges];
     else xs = best.x;
   }
@@ -156,6 +183,12 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
     return;
   }
   const Vec3 n = (c - x) / d;
+  // The side of the surface the centre is on: a ball that has passed
+  // through an edge or vertex (a long step of free flight) is behind it, and
+  // its gap is negative there as behind a face (−d − ρ; continuous at d = 0).
+  const Vec3 pseudo = S.pose.R * (on_edge ? idx.edge_normal[feature - idx.regions]
+                                          : idx.vertex_normal[feature - idx.regions - idx.edges]);
+  const double side = n.dot(pseudo) < 0 ? -1.0 : 1.0;
   const Vec3 u = body.at(c) - S.pointVelocity(c);
   Vec3 ndot = sup.w.cross(n);
   if (on_edge) {
@@ -168,7 +201,7 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
   }
   out.normal = n;
   out.normal_rate = ndot;
-  out.gap = d - sphere.radius;
+  out.gap = side * d - sphere.radius;
   const Vec3 m = -(pose.R.transpose() * n);
   const GaussPoint g = inverseGaussMap(sphere, m, opt.singular_tol);
   const Vec3 mdot = -(pose.R.transpose() * (ndot - body.w.cross(n)));

@@ -20,6 +20,8 @@
 #include <appell/shapes.hpp>
 #include <appell/supports.hpp>
 
+#include <span>
+
 namespace appell {
 
 struct ContactGeometry {
@@ -60,9 +62,16 @@ struct GeometryOptions {
 /// `latched_feature` ≥ 0 (a value of out.feature): the contact with that piece
 /// of a terrain only, extended past its bounds — the simulator keeps a closed
 /// contact on one piece between events (docs/contacts.md §4); −1 searches.
+/// `excluded` (a search only): the pieces the other points of the same pair
+/// hold (ContactSpec::points). The search then takes the nearest *separate*
+/// piece not among them — one where the distance to the terrain has a local
+/// minimum, a second place where the body touches (a ball in a valley on
+/// both slopes) — within a reach of the body's size; with none in reach,
+/// out.feature = −1 and out.gap = that reach, a lower bound of the gap.
 void contactGeometry(const Shape& shape, const SupportSurface& surface,
                      const SupportState& support, const SE3& body_pose,
                      const Vec6& body_velocity, ContactGeometry& out,
-                     const GeometryOptions& options = {}, int latched_feature = -1);
+                     const GeometryOptions& options = {}, int latched_feature = -1,
+                     std::span<const int> excluded = {});
 
 }  // namespace appell

@@ -28,6 +28,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <vector>
 
 namespace appell {
 
@@ -79,6 +80,11 @@ struct ContactSpec {
   bool unilateral = true;
   /// Newton's coefficient of restitution of its impacts, in [0, 1] (0: plastic).
   double restitution = 0;
+  /// How many places a smooth body may touch a terrain at once, 1 … 4 (a
+  /// ball in a valley touches both slopes; a tyre in a pothole its rim): one
+  /// unilateral contact per point (makeContactPoints), each on its own piece
+  /// of the terrain. 1 on every other support.
+  int points = 1;
   ContactOptions options;
 };
 
@@ -108,6 +114,10 @@ class ShapeContact : public Constraint {
     return std::isnan(spec_.mu_kinetic) ? spec_.mu : spec_.mu_kinetic;
   }
   double spinFriction() const override { return spec_.mu_spin; }
+  /// makeContactPoints: the pair's description (shared by its points) and
+  /// this point's index; null and 0 for a single contact.
+  const void* pointGroup() const override { return group_.get(); }
+  int pointSlot() const override { return slot_; }
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;
@@ -146,9 +156,13 @@ class ShapeContact : public Constraint {
   void writeRows(const SE3& body_pose, const Vec6& body_velocity, const SupportState& S,
                  RowBlock& out) const;
 
+  friend std::vector<std::shared_ptr<ShapeContact>> makeContactPoints(const ContactSpec& spec);
+
   ContactSpec spec_;
   Vec3 blade_ = Vec3::Zero();
   int rows_ = 0;
+  std::shared_ptr<const ContactSpec> group_;
+  int slot_ = 0;
 };
 
 /// Builds a contact from a declarative description. Throws std::invalid_argument
@@ -162,5 +176,14 @@ std::shared_ptr<ShapeContact> makeContact(const ContactSpec& spec);
 std::shared_ptr<ShapeContact> makeContact(ContactKind kind, int body, const Shape& shape,
                                           const Support& support,
                                           const ContactOptions& options = {});
+
+/// The spec.points contacts of a smooth body on a terrain, named
+/// "<name>/p0", "<name>/p1", … (one contact, named as given, for points = 1).
+/// Each is a unilateral contact with spec's kind, μ and restitution; the
+/// simulator keeps them on separate pieces of the terrain (docs/contacts.md
+/// §4). Throws std::invalid_argument naming the contact: points outside
+/// 1 … 4, more than one point on a support other than a terrain, or on a
+/// bilateral contact.
+std::vector<std::shared_ptr<ShapeContact>> makeContactPoints(const ContactSpec& spec);
 
 }  // namespace appell

@@ -24,6 +24,7 @@
 
 #include <appell/data.hpp>
 
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -79,6 +80,11 @@ struct RowBlock {
   /// closed contact on one piece between events (docs/contacts.md §4).
   int feature = -1;
   int latched_feature = -1;
+  /// A search's pieces to skip (the first `excluded_count`): the ones the
+  /// other points of the same pair hold (Constraint::pointGroup). The search
+  /// then takes only a separate piece — a second place the body touches.
+  std::array<int, 3> excluded_features{-1, -1, -1};
+  int excluded_count = 0;
   bool singular = false;            ///< the geometry is singular here (rows unusable)
   std::string singular_reason;      ///< why, when singular (set only then)
 };
@@ -131,6 +137,13 @@ class Constraint {
   /// dissipating force and torque of that ellipsoid (docs/contacts.md §8).
   /// NaN: none (the spin row is ideal while sticking, free while sliding).
   virtual double spinFriction() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// Several points of one pair (a ball that may touch a terrain in a valley
+  /// on both slopes): constraints with the same non-null token are the points
+  /// of one pair, numbered by pointSlot(). The simulator gives each point the
+  /// pieces its closed siblings hold to skip (RowBlock::excluded_features) and
+  /// lets only the first open point watch for a touchdown.
+  virtual const void* pointGroup() const { return nullptr; }
+  virtual int pointSlot() const { return 0; }
   /// Constant-size storage the block needs (called once, outside the step).
   virtual void reserve(const Model& model, RowBlock& block) const;
   /// Writes the rows at (q, v, t). `data` holds forwardKinematics(q, v).

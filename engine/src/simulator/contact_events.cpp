@@ -72,10 +72,27 @@ void Simulator::setUpUnilateral() {
       r.mu_k = mu_k;
       r.nf = cdata_->slide[c].n;
     }
+    r.slot = con.pointSlot();
     uni_->rows.push_back(r);
   }
   if (!uni_) return;
   auto& u = *uni_;
+  for (int i = 0; i < static_cast<int>(u.rows.size()); ++i) {
+    const void* group = constraints_[u.rows[i].c]->pointGroup();
+    if (!group) continue;
+    for (int j = 0; j < static_cast<int>(u.rows.size()); ++j)
+      if (j != i && constraints_[u.rows[j].c]->pointGroup() == group) {
+        if (u.rows[j].slot == u.rows[i].slot)
+          throw std::invalid_argument("Simulator: contacts '" +
+                                      constraints_[u.rows[i].c]->name() + "' and '" +
+                                      constraints_[u.rows[j].c]->name() +
+                                      "' are the same point of one pair");
+        u.rows[i].siblings.push_back(j);
+      }
+    if (u.rows[i].siblings.size() > cdata_->blocks[u.rows[i].c].excluded_features.size())
+      throw std::invalid_argument("Simulator: contact '" + constraints_[u.rows[i].c]->name() +
+                                  "' has more than 4 points");
+  }
   u.q0 = q_;
   u.v0 = v_;
   u.vplus = v_;
@@ -145,7 +162,7 @@ int Simulator::crossedConstraint(detail::Crossing& type) const {
     const UnilateralRow& r = uni_->rows[k];
     type = Crossing::None;
     if (!cdata_->isActive(r.c)) {
-      if (cdata_->gap[r.global] < 0) type = Crossing::Gap;
+      if (!r.dormant && cdata_->gap[r.global] < 0) type = Crossing::Gap;
     } else if (options_.evaluate_end_state) {
       const double fn = result_.lambda[r.global];
       if (fn < -ftol) type = Crossing::Normal;
@@ -299,7 +316,8 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h, int k,
       if (j == k && type != detail::Crossing::Feature) continue;
       const UnilateralRow& r = u.rows[j];
       if (!cdata_->isActive(r.c)) {
-        if (cdata_->gap[r.global] < -o.gap_tol) earlier = j, earlier_type = detail::Crossing::Gap;
+        if (!r.dormant && cdata_->gap[r.global] < -o.gap_tol)
+          earlier = j, earlier_type = detail::Crossing::Gap;
       } else if (cdata_->isSliding(r.c)) {
         if (eventFunction(j, detail::Crossing::Slip) < -o.speed_tol)
           earlier = j, earlier_type = detail::Crossing::Slip;
@@ -447,7 +465,8 @@ void Simulator::saveCandidateRows() {
   for (auto& r : u.rows) {
     r.gap = cdata_->gap[r.global];
     r.touching = !r.bounced && (cdata_->isActive(r.c) ||
-                                std::abs(r.gap) <= options_.contacts.gap_tol || r.touching_down);
+                                (!r.dormant && std::abs(r.gap) <= options_.contacts.gap_tol) ||
+                                r.touching_down);
     if (r.touching) cdata_->setActive(r.c, true);
   }
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
@@ -530,8 +549,24 @@ bool Simulator::impactPhase(std::string& error) {
     shiftImpactTargets();
     u.vplus = v_;
     if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
-      error = "impact: the impulse solve failed: " + solver_->lastError();
-      return false;
+      // Restitution targets on redundant rows can contradict each other: a
+      // ball resting on one slope of a valley that strikes the other with
+      // e > 0 cannot both rebound there and keep rolling on the first (two
+      // points of one rigid body keep their distance). A set member at rest
+      // (no target) is then the one that gives way: it leaves the set, and
+      // the pivoting goes on (it rejoins if it would approach).
+      int resting = -1;
+      for (int k = 0; k < static_cast<int>(u.rows.size()) && resting < 0; ++k) {
+        const auto& r = u.rows[k];
+        if (r.touching && r.in_set && r.target == 0 && r.gamma >= -o.speed_tol) resting = k;
+      }
+      if (resting < 0) {
+        error = "impact: the impulse solve failed: " + solver_->lastError();
+        return false;
+      }
+      u.rows[resting].in_set = false;
+      last_flip = resting;
+      continue;
     }
     std::swap(v_, u.vplus);  // rowVelocity reads v_ and data_ at v⁺
     forwardKinematics(model_, *data_, q_, v_);

@@ -33,16 +33,44 @@ using detail::UnilateralRow;
 
 /// Closed contacts use their latched piece; open ones search (their gap is
 /// the distance to the nearest piece, the touchdown's event function).
+///
+/// Points of one pair (Constraint::pointGroup): of the open points only the
+/// lowest slot watches — the others idle (dormant), or all would touch down
+/// on one piece together. The watcher's search skips the pieces the closed
+/// points hold: it finds the nearest *separate* piece, a second place the
+/// body may touch. A closed point's search skips the other closed points'
+/// pieces and the watcher's: where the body reaches the watched piece (a
+/// ball sliding down one slope of a valley meets the other) that is the
+/// watcher's touchdown, not a jump of the closed point onto it.
 void Simulator::applyLatches() {
-  for (const UnilateralRow& r : uni_->rows)
-    if (!r.joint)
-      cdata_->blocks[r.c].latched_feature = cdata_->isActive(r.c) ? r.feature : -1;
+  auto& rows = uni_->rows;
+  for (UnilateralRow& r : rows) {
+    if (r.joint) continue;
+    r.dormant = false;
+    if (cdata_->isActive(r.c)) continue;
+    for (int j : r.siblings)
+      if (!cdata_->isActive(rows[j].c) && rows[j].slot < r.slot) r.dormant = true;
+  }
+  for (UnilateralRow& r : rows) {
+    if (r.joint) continue;
+    RowBlock& blk = cdata_->blocks[r.c];
+    const bool closed = cdata_->isActive(r.c);
+    blk.latched_feature = closed ? r.feature : -1;
+    blk.excluded_count = 0;
+    for (int j : r.siblings) {
+      const UnilateralRow& s = rows[j];
+      const bool held = cdata_->isActive(s.c), watched = closed && !held && !s.dormant;
+      if ((held || watched) && s.feature >= 0)
+        blk.excluded_features[blk.excluded_count++] = s.feature;
+    }
+  }
 }
 
 /// Whether closed row r has moved to a piece that is neither its latched one
-/// nor the one it had at the step's start (after searchFeatures).
+/// nor the one it had at the step's start (after searchFeatures). A search
+/// that found no separate piece in reach (−1) is no switch.
 static bool switched(const UnilateralRow& r) {
-  return r.feature_free != r.feature && r.feature_free != r.feature_start;
+  return r.feature_free >= 0 && r.feature_free != r.feature && r.feature_free != r.feature_start;
 }
 
 /// Searches every contact's nearest piece at (t_, q_, v_) into feature_free
@@ -98,7 +126,8 @@ void Simulator::switchFeatures(bool lookahead) {
     int next = r.feature;
     if (!cdata_->isActive(r.c)) next = r.feature_free;
     else if (switched(r)) next = r.feature_free;
-    else if (lookahead && ahead != r.feature && ahead != r.feature_start && ahead != r.feature_free)
+    else if (lookahead && ahead >= 0 && ahead != r.feature && ahead != r.feature_start &&
+             ahead != r.feature_free)
       next = ahead;
     const bool logged = cdata_->isActive(r.c) && next != r.feature;
     r.feature = next;
@@ -108,6 +137,13 @@ void Simulator::switchFeatures(bool lookahead) {
       events_.back().feature = next;
     }
   }
+  // Two points of one pair on one piece are one place of contact: the
+  // higher slot opens (it watches again for a separate piece).
+  for (UnilateralRow& r : u.rows)
+    for (int j : r.siblings)
+      if (u.rows[j].slot < r.slot && cdata_->isActive(r.c) && cdata_->isActive(u.rows[j].c) &&
+          u.rows[j].feature == r.feature)
+        cdata_->setActive(r.c, false);
   applyLatches();
 }
 

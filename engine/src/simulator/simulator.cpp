@@ -77,13 +77,21 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
     // A new state: unilateral constraints with clearance start open, the
     // touching ones get their modes decided (impact, then forces), each on
     // its nearest piece.
+    // The points of a pair close one per pass: each next one searches past
+    // the pieces the closed ones hold.
     for (auto& r : uni_->rows) cdata_->setActive(r.c, false);
-    applyLatches();
-    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    for (auto& r : uni_->rows) {
-      r.lifting = r.touching_down = false;
-      r.feature = r.feature_start = r.feature_free = r.joint ? -1 : cdata_->blocks[r.c].feature;
-      cdata_->setActive(r.c, cdata_->gap[r.global] <= options_.contacts.gap_tol);
+    for (bool more = true; more;) {
+      more = false;
+      applyLatches();
+      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+      for (auto& r : uni_->rows) {
+        if (cdata_->isActive(r.c)) continue;
+        r.lifting = r.touching_down = false;
+        r.feature = r.feature_start = r.feature_free = r.joint ? -1 : cdata_->blocks[r.c].feature;
+        if (r.dormant || !(cdata_->gap[r.global] <= options_.contacts.gap_tol)) continue;
+        cdata_->setActive(r.c, true);
+        more = more || !r.siblings.empty();
+      }
     }
     if (!decideModes(state_error_) || !frictionPhase(state_error_))
       state_error_ = "initial contact modes: " + state_error_;

@@ -64,6 +64,12 @@ struct UnilateralRow {
   // rows use between events (RowBlock::latched_feature), the nearest piece at
   // the step's start, and the nearest one at the state last searched.
   int feature = -1, feature_start = -1, feature_free = -1;
+  // Points of one pair (Constraint::pointGroup): the other points' rows,
+  // this one's slot, and whether it idles — open while a point of lower slot
+  // is open too, which is the one watching for the next touchdown.
+  std::vector<int> siblings;
+  int slot = 0;
+  bool dormant = false;
 };
 
 /// The friction forces of a set of contacts as the unknowns of one problem

@@ -135,7 +135,7 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
   if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
   static const char* const kCommon[] = {"name",      "link",        "kind",      "support",
                                         "mu",        "direction",   "restitution", "unilateral",
-                                        "mu_static", "mu_kinetic", "mu_spin"};
+                                        "mu_static", "mu_kinetic", "mu_spin",  "points"};
   auto allow = [&](const std::vector<const char*>& extra) {
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string n = a->Name();
@@ -232,6 +232,13 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
     d.spec.restitution = number(src, e, "restitution");
     if (!(d.spec.restitution >= 0 && d.spec.restitution <= 1))
       fail(src, e, "restitution must lie in [0, 1] (0: plastic, 1: elastic)");
+  }
+  if (has(e, "points")) {
+    const double n = number(src, e, "points");
+    if (!(n >= 1 && n <= 4 && n == std::floor(n)))
+      fail(src, e, "'points' must be a whole number from 1 to 4 (places the body may touch a "
+                   "terrain at once)");
+    d.spec.points = static_cast<int>(n);
   }
   if (has(e, "unilateral")) {
     const std::string u = text(src, e, "unilateral");

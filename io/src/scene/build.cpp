@@ -213,7 +213,11 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
     std::vector<std::shared_ptr<ShapeContact>> made;
     try {
       if (isSmoothContactShape(spec.shape))
-        made.push_back(makeContact(spec));
+        made = makeContactPoints(spec);
+      else if (spec.points > 1)
+        throw std::invalid_argument("contact '" + spec.options.name +
+                                    "': 'points' applies to a smooth shape on a terrain; a " +
+                                    shapeName(spec.shape) + " touches with its vertices");
       else
         made = makeVertexContacts(spec, c.rim_points > 0 ? c.rim_points : 16);
     } catch (const std::invalid_argument& e) {
@@ -233,7 +237,8 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
     }
     for (int k = 0; k < static_cast<int>(made.size()); ++k) {
       ContactOrigin o = origin;
-      if (made.size() > 1) o.shape_source += ", vertex " + std::to_string(k);
+      if (made.size() > 1)
+        o.shape_source += (spec.points > 1 ? ", point " : ", vertex ") + std::to_string(k);
       scene.constraints.push_back(made[k]);
       scene.contacts.push_back(std::move(made[k]));
       scene.contact_origins.push_back(std::move(o));

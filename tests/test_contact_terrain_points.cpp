@@ -1,0 +1,261 @@
+// Where a body meets a terrain at more than one place (ContactSpec::points):
+// a ball in a valley rests on both slopes. And where it meets an edge.
+#include <gtest/gtest.h>
+
+#include <appell/contacts.hpp>
+#include <appell/simulator.hpp>
+#include <appell/terrain.hpp>
+
+#include "scene.hpp"
+#include "simulation_helpers.hpp"
+
+#include <cmath>
+
+using namespace appell;
+using namespace appell::scenes;
+
+namespace {
+
+constexpr double kG = 9.81;
+
+// Two planes meeting along the y axis at slope α: a valley (z = |x| tan α)
+// or, with ridge, a roof (z = −|x| tan α). Faces wound to point up.
+TerrainMesh trough(double alpha, bool ridge = false) {
+  const double w = 2, l = 2, h = (ridge ? -1 : 1) * w * std::tan(alpha);
+  return makeTerrain({{-w, -l, h}, {0, -l, 0}, {0, l, 0}, {-w, l, h}, {w, -l, h}, {w, l, h}},
+                     {{0, 1, 2}, {0, 2, 3}, {1, 4, 5}, {1, 5, 2}});
+}
+
+// A grid of sines, 0.5 m by 0.75 m cells, heights within ±5 cm: valleys,
+// ridges and saddles in every direction.
+TerrainMesh bumpy() {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> f;
+  const int nx = 60, ny = 8;
+  for (int i = 0; i <= nx; ++i)
+    for (int j = 0; j <= ny; ++j) {
+      const double x = -5 + 0.5 * i, y = -3 + 0.75 * j;
+      v.emplace_back(x, y, 0.03 * std::sin(1.7 * x) * std::cos(1.1 * y) + 0.02 * std::sin(0.9 * x + 2.3 * y));
+    }
+  auto at = [&](int i, int j) { return i * (ny + 1) + j; };
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      f.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      f.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return makeTerrain(v, f);
+}
+
+Model ballModel(double mass, double rho) {
+  ModelBuilder b;
+  b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+            principalInertia(mass, Vec3::Constant(0.4 * mass * rho * rho)), "free");
+  return b.build();
+}
+
+}  // namespace
+
+// Protects touchdown on an edge. A ball falling onto a ridge touches the
+// ridge's edge first (its centre is in the edge's wedge): it lands at the
+// fall time t = √(2 (z₀ − √(ρ² − x₀²)) / g) to 1e-10, then pivots about the
+// ridge and rolls down the slope. The sphere (nearest point) and an
+// equal-axes ellipsoid (every other shape's face and edge search) alike;
+// the ellipsoid's edge contact, refused once it sank 1e-6 m past the edge,
+// used to be found only on the faces' extended planes, 8 ms late.
+TEST(ContactTerrainPoints, ABallFallingOntoARidgeLandsOnItsEdge) {
+  const double rho = 0.1, mass = 0.5, x0 = 0.02, z0 = 1.5, alpha = 0.35;
+  const Support roof{trough(alpha, true), StaticMotion{}, "roof"};
+  for (const Shape& shape : {Shape{Sphere{rho}}, Shape{Ellipsoid{Vec3::Constant(rho)}}}) {
+    SCOPED_TRACE(shapeName(shape));
+    const Model model = ballModel(mass, rho);
+    ContactSpec spec;
+    spec.kind = ContactKind::Rolling;
+    spec.body = 0;
+    spec.shape = shape;
+    spec.support = roof;
+    const ConstraintList list{makeContact(spec)};
+    VecX q = neutralConfiguration(model);
+    q.head<3>() = Vec3(x0, 0, z0);
+    IntegratorOptions long_steps = appell::test::tightIntegrator();
+    long_steps.h_max = 0.1;  // the default: free flight is one step per 0.1 s
+    Simulator sim(model, list, makeSolver(Formulation::Tree, model, list),
+                  IntegratorType::DormandPrince54, long_steps);
+    ASSERT_TRUE(sim.setState(0, q, VecX::Zero(model.nv))) << sim.lastStateError();
+    ASSERT_FALSE(sim.isClosed(0));
+    const auto run = appell::test::runWatching(
+        sim, 1.0, [](const Simulator& s) { return s.q()[2]; }, 0.5);
+    const auto events = run.modeEvents();
+    ASSERT_GE(events.size(), 1u);
+    EXPECT_EQ(events[0].kind, ContactEventKind::Touchdown);
+    EXPECT_NEAR(events[0].t, std::sqrt(2 * (z0 - std::sqrt(rho * rho - x0 * x0)) / kG), 1e-10)
+        << "lands on the ridge";
+    EXPECT_NEAR(run.at_event[0], std::sqrt(rho * rho - x0 * x0), 1e-9);
+    // Off the ridge and down the slope: on the +x face, above it.
+    EXPECT_GT(sim.q()[0], x0);
+    const double gap = sim.q()[0] * std::sin(alpha) + sim.q()[2] * std::cos(alpha) - rho;
+    EXPECT_GT(gap, -1e-9) << "never below the terrain";
+    EXPECT_LT(run.worst_energy, 1e-9 * mass * kG * z0);
+  }
+}
+
+// Protects the second point of a pair. A frictionless ball dropped into a
+// V-shaped valley (slopes ±α = 30°) lands on slope A and slides down it to
+// the bottom, where it meets slope B: a second place of contact, which one
+// contact per pair cannot hold (its piece would flip between the slopes at
+// every step). With points = 2 the second point watches the nearest piece
+// separate from the first's and touches down on B at the analytic time. The
+// plastic impact there removes the velocity along B's normal and keeps the
+// rest, s cos 2α up slope B: the first point lifts off A. The ball slides up
+// B and back, meets A at the bottom, and so on — each crossing keeps cos 2α
+// of the speed and takes 2 s cos 2α/(g sin α), a Zeno sequence ending at
+//   t∞ = t₂ + 2 s₀ cos 2α / ((1 − cos 2α) g sin α).
+// Below the rest speed the contact an impact would unload is held: the ball
+// rests on both slopes, at the bottom, with normal loads m g / (2 cos α). The
+// sphere (nearest-point geometry) and an equal-axes ellipsoid (the face and
+// edge search of every other shape) alike, with every formulation:
+//   t₁ = √(2 (z₀ − z₁)/g),  z₁ = (ρ − x₀ sin α)/cos α;
+//   on A: ẍ = g sin α cos α from ẋ = g t₁ sin α cos α (the first impact
+//   keeps the velocity along A), at x = 0 after τ = (−ẋ + √(ẋ² − 2ẍx₀))/ẍ,
+//   with speed s₀ = (ẋ + ẍτ)/cos α.
+TEST(ContactTerrainPoints, ABallDroppedIntoAValleyComesToRestOnBothSlopes) {
+  const double rho = 0.1, mass = 0.5, alpha = M_PI / 6, x0 = -0.3, z0 = 2.0;
+  const Support valley{trough(alpha), StaticMotion{}, "valley"};
+  const double z1 = (rho - x0 * std::sin(alpha)) / std::cos(alpha);
+  const double t1 = std::sqrt(2 * (z0 - z1) / kG);
+  const double a = kG * std::sin(alpha) * std::cos(alpha), u = a * t1;
+  const double tau = (-u + std::sqrt(u * u - 2 * a * x0)) / a;
+  const double t2 = t1 + tau, s0 = (u + a * tau) / std::cos(alpha), keep = std::cos(2 * alpha);
+  const double t_end = t2 + 2 * s0 * keep / ((1 - keep) * kG * std::sin(alpha));
+  for (const Shape& shape : {Shape{Sphere{rho}}, Shape{Ellipsoid{Vec3::Constant(rho)}}}) {
+    SCOPED_TRACE(shapeName(shape));
+    const Model model = ballModel(mass, rho);
+    ContactSpec spec;
+    spec.kind = ContactKind::Sliding;
+    spec.body = 0;
+    spec.shape = shape;
+    spec.support = valley;
+    spec.points = 2;
+    spec.options.name = "ball";
+    const auto points = makeContactPoints(spec);
+    ASSERT_EQ(points.size(), 2u);
+    EXPECT_EQ(points[1]->name(), "ball/p1");
+    const ConstraintList list{points[0], points[1]};
+    VecX q = neutralConfiguration(model);
+    q.head<3>() = Vec3(x0, 0, z0);
+    for (Formulation form : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
+      SCOPED_TRACE(toString(form));
+      IntegratorOptions long_steps = appell::test::tightIntegrator();
+      long_steps.h_max = 0.1;  // a step of free flight carries it past the crease
+      Simulator sim(model, list, makeSolver(form, model, list), IntegratorType::DormandPrince54,
+                    long_steps);
+      ASSERT_TRUE(sim.setState(0, q, VecX::Zero(model.nv))) << sim.lastStateError();
+      const auto run = appell::test::runWatching(
+          sim, t_end + 0.5, [](const Simulator& s) { return s.q()[0]; });
+      std::vector<ContactEvent> touchdowns;
+      for (const ContactEvent& e : run.modeEvents())
+        if (e.kind == ContactEventKind::Touchdown) touchdowns.push_back(e);
+      ASSERT_GE(touchdowns.size(), 10u);
+      EXPECT_LT(touchdowns.size(), 30u) << "the sequence ends";
+      EXPECT_EQ(touchdowns[0].constraint, 0);
+      EXPECT_NEAR(touchdowns[0].t, t1, 1e-10) << "lands on slope A";
+      // The k-th crossing of the bottom: the points take turns, at speed
+      // s₀ cos^k 2α, after the flights up and down the slopes.
+      double t = t2, s = s0;
+      for (size_t k = 1; k < touchdowns.size(); ++k) {
+        SCOPED_TRACE(k);
+        const ContactEvent& e = touchdowns[k];
+        EXPECT_EQ(e.constraint, static_cast<int>(k % 2)) << "the points take turns";
+        EXPECT_NEAR(e.t, t, 1e-9);
+        if (s > 2 * ContactEventOptions{}.rest_speed) {
+          EXPECT_NEAR(e.speed_before, -s * std::sin(2 * alpha), 1e-9 * s0);
+        }
+        t += 2 * s * keep / (kG * std::sin(alpha));
+        s *= keep;
+      }
+      EXPECT_LT(touchdowns.back().t, t_end) << "before the accumulation point";
+      ASSERT_TRUE(sim.isClosed(0));
+      ASSERT_TRUE(sim.isClosed(1));
+      EXPECT_LT(sim.v().norm(), 1e-9) << "at rest";
+      EXPECT_NEAR(sim.q()[0], 0, 1e-9);
+      EXPECT_NEAR(sim.q()[2], rho / std::cos(alpha), 1e-9);
+      const double load = mass * kG / (2 * std::cos(alpha));
+      EXPECT_NEAR(sim.lambda()[0], load, 1e-8);
+      EXPECT_NEAR(sim.lambda()[1], load, 1e-8);
+      EXPECT_LT(run.worst_energy, 1e-9 * mass * kG * z0);
+    }
+  }
+}
+
+// Protects contact on a mesh of ridges, saddles and creases. A rolling ball
+// (μ = 0.8, e = 0.6) dropped on a bumpy mesh bounces and rolls 8 s over it,
+// across ridges, saddles and concave creases (each a change of piece, an
+// impact at a crease), in long steps of free flight between bounces. It
+// runs to the end on the mesh with E + impact losses + friction work
+// conserved to 1e-8 J, through more than 50 events, and two formulations
+// agree on the end state.
+TEST(ContactTerrainPoints, ABallBouncesAndRollsOverABumpyMeshWithoutFallingThrough) {
+  const double rho = 0.1, mass = 0.5;
+  const Support ground{bumpy(), StaticMotion{}, "bumpy"};
+  const Model model = ballModel(mass, rho);
+  VecX q = neutralConfiguration(model);
+  q.head<3>() = Vec3(0, 0, 1.1);  // over the grid line y = 0: a ridge below
+  VecX v = VecX::Zero(model.nv);
+  v[3] = 2;
+  ContactSpec spec;
+  spec.kind = ContactKind::Rolling;
+  spec.body = 0;
+  spec.shape = Sphere{rho};
+  spec.support = ground;
+  spec.mu = 0.8;
+  spec.restitution = 0.6;
+  const ConstraintList list{makeContact(spec)};
+  VecX end[2];
+  int k = 0;
+  for (Formulation form : {Formulation::Tree, Formulation::Appell}) {
+    SCOPED_TRACE(toString(form));
+    IntegratorOptions long_steps = appell::test::tightIntegrator();
+    long_steps.h_max = 0.1;  // the default: long steps of free flight
+    Simulator sim(model, list, makeSolver(form, model, list), IntegratorType::DormandPrince54,
+                  long_steps);
+    ASSERT_TRUE(sim.setState(0, q, v)) << sim.lastStateError();
+    double lowest = INFINITY;
+    const auto run = appell::test::runWatching(
+        sim, 8.0, [&](const Simulator& s) { return s.q()[2]; }, 0.05);
+    for (double z : run.at_event) lowest = std::min(lowest, z);
+    EXPECT_GT(run.modeEvents().size(), 50u);
+    EXPECT_GT(lowest, rho - 0.06) << "on the mesh (heights within ±5 cm) at every event";
+    EXPECT_GT(sim.q()[2], rho - 0.06);
+    EXPECT_LT(run.worst_energy, 1e-8);
+    end[k++] = sim.q();
+  }
+  EXPECT_LT((end[0] - end[1]).norm(), 1e-6);
+}
+
+// Protects the description's checks: points outside 1 … 4, several points
+// on a support other than a terrain, or on a bilateral contact, are errors
+// naming the contact.
+TEST(ContactTerrainPoints, BadPointCountsAreRefusedNamingTheContact) {
+  ContactSpec spec;
+  spec.kind = ContactKind::Rolling;
+  spec.body = 0;
+  spec.shape = Sphere{0.1};
+  spec.support = Support{trough(0.3), StaticMotion{}, "valley"};
+  spec.options.name = "wheel";
+  using appell::test::invalidArgumentMessage;
+  spec.points = 5;
+  EXPECT_NE(invalidArgumentMessage([&] { makeContactPoints(spec); })
+                .find("contact 'wheel': 'points' must be 1 … 4"),
+            std::string::npos);
+  spec.points = 2;
+  EXPECT_NE(invalidArgumentMessage([&] { makeContact(spec); }).find("makeContactPoints"),
+            std::string::npos);
+  spec.unilateral = false;
+  EXPECT_NE(invalidArgumentMessage([&] { makeContactPoints(spec); })
+                .find("contact 'wheel': more than one point needs a unilateral contact"),
+            std::string::npos);
+  spec.unilateral = true;
+  spec.support = Support{Plane{}, StaticMotion{}, "floor"};
+  EXPECT_NE(invalidArgumentMessage([&] { makeContactPoints(spec); })
+                .find("contact 'wheel': more than one point needs a terrain support"),
+            std::string::npos);
+}
