@@ -55,6 +55,51 @@ Model ballModel(double mass, double rho) {
 
 }  // namespace
 
+// A square pit: four faces falling at slope α to a bottom vertex at the
+// origin (an inverted pyramid, half-width w).
+TerrainMesh pit(double alpha) {
+  const double w = 2, h = w * std::tan(alpha);
+  return makeTerrain({{0, 0, 0}, {w, -w, h}, {w, w, h}, {-w, w, h}, {-w, -w, h}},
+                     {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}});
+}
+
+// Protects the sign of the gap at a terrain vertex. A 1 cm ball dropped from 5 m
+// over a pit falls ~1 m per step of free flight at landing (0.1 s steps). A
+// step that carries its centre below the pit's bottom vertex leaves it
+// nearest to that vertex — from below, where the distance is positive too:
+// it used to fall through the terrain unseen. The gap there is signed by the
+// vertex's angle-weighted pseudonormal, so the step is seen to cross and the
+// landing is located: on the face it is nearest, at
+//   t = √(2 (z₀ − z₁)/g),  z₁ = (ρ + x₀ sin α)/cos α,
+// to 1e-10 (x₀ > |y₀| puts it over the +x face).
+TEST(ContactTerrainPoints, ABallFallingIntoAPitLandsInsteadOfPassingThroughItsBottom) {
+  const double rho = 0.01, mass = 0.05, alpha = 0.3, x0 = 0.001, y0 = 0.0004, z0 = 5;
+  const Support ground{pit(alpha), StaticMotion{}, "pit"};
+  const Model model = ballModel(mass, rho);
+  ContactSpec spec;
+  spec.kind = ContactKind::Rolling;
+  spec.body = 0;
+  spec.shape = Sphere{rho};
+  spec.support = ground;
+  const ConstraintList list{makeContact(spec)};
+  VecX q = neutralConfiguration(model);
+  q.head<3>() = Vec3(x0, y0, z0);
+  IntegratorOptions long_steps = appell::test::tightIntegrator();
+  long_steps.h_max = 0.1;
+  Simulator sim(model, list, makeSolver(Formulation::Tree, model, list),
+                IntegratorType::DormandPrince54, long_steps);
+  ASSERT_TRUE(sim.setState(0, q, VecX::Zero(model.nv))) << sim.lastStateError();
+  const auto run = appell::test::runWatching(
+      sim, 1.5, [](const Simulator& s) { return s.q()[2]; }, 0.5);
+  const auto events = run.modeEvents();
+  ASSERT_GE(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, ContactEventKind::Touchdown);
+  const double z1 = (rho + x0 * std::sin(alpha)) / std::cos(alpha);
+  EXPECT_NEAR(events[0].t, std::sqrt(2 * (z0 - z1) / kG), 1e-10) << "lands on the +x face";
+  EXPECT_NEAR(run.at_event[0], z1, 1e-9);
+  EXPECT_GT(sim.q()[2], rho) << "still in the pit, above its bottom";
+}
+
 // Protects touchdown on an edge. A ball falling onto a ridge touches the
 // ridge's edge first (its centre is in the edge's wedge): it lands at the
 // fall time t = √(2 (z₀ − √(ρ² − x₀²)) / g) to 1e-10, then pivots about the
@@ -229,6 +274,49 @@ TEST(ContactTerrainPoints, ABallBouncesAndRollsOverABumpyMeshWithoutFallingThrou
     end[k++] = sim.q();
   }
   EXPECT_LT((end[0] - end[1]).norm(), 1e-6);
+}
+
+// Protects the agreement of the two descriptions where one place of contact
+// suffices. The same ball over the same mesh, with one point and with two:
+// with one point a concave crease is a change of piece with an impact; with
+// two it may instead be the second point's touchdown on the rising face and
+// the first point's lift-off from the old one, and at a convex edge the
+// second point must not take the face beyond the edge the first is crossing
+// (the same place of contact). The same motion either way: the end states
+// agree to 1e-8 and the impact losses to 1e-9 of m g·1 m.
+TEST(ContactTerrainPoints, OneAndTwoPointsRollTheSameBallOverABumpyMesh) {
+  const double rho = 0.1, mass = 0.5;
+  const Support ground{bumpy(), StaticMotion{}, "bumpy"};
+  const Model model = ballModel(mass, rho);
+  VecX q = neutralConfiguration(model);
+  q.head<3>() = Vec3(0, 0.1, 1.1);
+  VecX v = VecX::Zero(model.nv);
+  v[3] = 2;
+  VecX end[2];
+  double loss[2];
+  for (int points : {1, 2}) {
+    SCOPED_TRACE(points);
+    ContactSpec spec;
+    spec.kind = ContactKind::Rolling;
+    spec.body = 0;
+    spec.shape = Sphere{rho};
+    spec.support = ground;
+    spec.mu = 0.8;
+    spec.restitution = 0.6;
+    spec.points = points;
+    ConstraintList list;
+    for (auto& c : makeContactPoints(spec)) list.push_back(c);
+    Simulator sim(model, list, makeSolver(Formulation::Tree, model, list),
+                  IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+    ASSERT_TRUE(sim.setState(0, q, v)) << sim.lastStateError();
+    const auto run = appell::test::runWatching(sim, 8.0, [](const Simulator&) { return 0.0; }, 0.05);
+    EXPECT_GT(run.modeEvents().size(), 50u);
+    EXPECT_LT(run.worst_energy, 1e-8);
+    end[points - 1] = sim.q();
+    loss[points - 1] = sim.impactEnergyLoss();
+  }
+  EXPECT_LT((end[0] - end[1]).norm(), 1e-8);
+  EXPECT_NEAR(loss[0], loss[1], 1e-9 * mass * kG);
 }
 
 // Protects the description's checks: points outside 1 … 4, several points

@@ -155,6 +155,22 @@ bool separatePiece(const TerrainMesh& t, int feature, const Vec3& n) {
   return true;
 }
 
+Vec3 nearestOnPiece(const TerrainMesh& t, int feature, const Vec3& p) {
+  const TerrainIndex& idx = *t.index;
+  if (feature < idx.regions) {
+    const int f = idx.region_face[feature];
+    const Vec3& n = idx.normal[f];
+    return p - n * n.dot(p - t.vertices[t.triangles[f][0]]);
+  }
+  if (feature < idx.regions + idx.edges) {
+    const auto& ends = idx.edge_ends[feature - idx.regions];
+    const Vec3& a = t.vertices[ends[0]];
+    const Vec3 e = (t.vertices[ends[1]] - a).normalized();
+    return a + e * e.dot(p - a);
+  }
+  return t.vertices[feature - idx.regions - idx.edges];
+}
+
 void noPieceInReach(const SupportState& S, const SE3& pose, double reach, ContactGeometry& out) {
   out = ContactGeometry{};
   out.normal = S.pose.R.col(2);

@@ -4,6 +4,7 @@
 #include "terrain_index.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -141,11 +142,23 @@ void separateGeometry(const Shape& shape, const TerrainMesh& t, const SupportSta
   double best_gap = margin;
   int best = -1;
   ContactGeometry trial;
+  // Where the body touches the excluded pieces (extended, as latched): a
+  // candidate there is the same place of contact seen from the next piece.
+  std::array<Vec3, 4> held;
+  int nheld = 0;
+  for (int e : excluded) {
+    if (nheld == 4) break;
+    latchedGeometry(shape, t, e, S, pose, V, trial, opt);
+    if (!trial.singular) held[nheld++] = trial.support_point;
+  }
+  const double same = kSamePlace * boundingRadius(shape);
   auto take = [&](int piece) {
     const Vec3 n = S.pose.R.transpose() * trial.normal;
     if (!(trial.gap < best_gap) || excludedPiece(excluded, piece) ||
         !frontSide(idx, piece, n) || !separatePiece(t, piece, n))
       return;
+    for (int i = 0; i < nheld; ++i)
+      if ((trial.support_point - held[i]).norm() <= same) return;
     best = piece;
     best_gap = trial.gap;
     out = trial;

@@ -134,6 +134,14 @@ void noPieceInReach(const SupportState& S, const SE3& pose, double reach, Contac
 /// Real-Time Collision Detection, 2005, §5.1.5) over the whole surface.
 bool separatePiece(const TerrainMesh& terrain, int feature, const Vec3& n);
 
+/// The point of piece `feature` nearest to p (support frame): on a region's
+/// plane, an edge's line or at a vertex — the piece extended, as latched.
+Vec3 nearestOnPiece(const TerrainMesh& terrain, int feature, const Vec3& p);
+
+/// Two contact points closer than this (relative to the body's size) are one
+/// place of contact: a separate piece there is the held one's neighbour.
+constexpr double kSamePlace = 1e-6;
+
 /// Whether `feature` is one of `excluded`.
 inline bool excludedPiece(std::span<const int> excluded, int feature) {
   for (int e : excluded)

@@ -22,6 +22,8 @@
 #include "geometry_internal.hpp"
 #include "terrain_index.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace appell::detail {
@@ -95,6 +97,12 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
     // separate piece within 2ρ of the centre, else a gap of ρ.
     const double reach = 2 * sphere.radius;
     double best_d2 = reach * reach;
+    // Where the excluded pieces are nearest the centre: a candidate whose
+    // nearest point is there is the same place of contact seen from the
+    // next piece (at the instant a held contact crosses onto it).
+    std::array<Vec3, 4> held;
+    const int nheld = std::min<int>(static_cast<int>(excluded.size()), 4);
+    for (int i = 0; i < nheld; ++i) held[i] = nearestOnPiece(terrain, excluded[i], cs);
     forEachFaceInBox(idx, cs.array() - reach, cs.array() + reach, [&](int f) {
       const auto& tri = terrain.triangles[f];
       const Nearest nr = nearestOnTriangle(cs, terrain.vertices[tri[0]], terrain.vertices[tri[1]],
@@ -105,6 +113,8 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
       if (excludedPiece(excluded, piece) ||
           !separatePiece(terrain, piece, (cs - nr.x) / std::sqrt(d2)))
         return;
+      for (int i = 0; i < nheld; ++i)
+        if ((nr.x - held[i]).norm() <= kSamePlace * sphere.radius) return;
       best_d2 = d2;
       feature = piece;
       xs = nr.x;

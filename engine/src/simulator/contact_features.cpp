@@ -137,13 +137,6 @@ void Simulator::switchFeatures(bool lookahead) {
       events_.back().feature = next;
     }
   }
-  // Two points of one pair on one piece are one place of contact: the
-  // higher slot opens (it watches again for a separate piece).
-  for (UnilateralRow& r : u.rows)
-    for (int j : r.siblings)
-      if (u.rows[j].slot < r.slot && cdata_->isActive(r.c) && cdata_->isActive(u.rows[j].c) &&
-          u.rows[j].feature == r.feature)
-        cdata_->setActive(r.c, false);
   applyLatches();
 }
 
