@@ -5,6 +5,7 @@
 #include <appell/contacts.hpp>
 #include <appell/simulator.hpp>
 #include <appell/terrain.hpp>
+#include <appell/urdf.hpp>
 
 #include "scene.hpp"
 #include "simulation_helpers.hpp"
@@ -346,4 +347,45 @@ TEST(ContactTerrainPoints, BadPointCountsAreRefusedNamingTheContact) {
   EXPECT_NE(invalidArgumentMessage([&] { makeContactPoints(spec); })
                 .find("contact 'wheel': more than one point needs a terrain support"),
             std::string::npos);
+}
+
+// Protects the scene format's `points`: a ball declared with points="2" on a
+// terrain loads as two contacts ball/p0 and ball/p1 (their origin names the
+// point); points on a plane, or outside 1 … 4, are errors naming the file,
+// the <contact> element and the reason.
+TEST(ContactTerrainPoints, TheSceneFormatDeclaresPointsAndRefusesBadOnes) {
+  const std::string urdf = R"(<?xml version="1.0"?>
+<robot name="ball">
+  <link name="ball">
+    <inertial><mass value="0.5"/><inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial>
+    <collision><geometry><sphere radius="0.1"/></geometry></collision>
+  </link>
+  <appell>
+    <support name="hills" type="terrain" filename=")" APPELL_SOURCE_DIR R"(/examples/car_bump/bump.obj"/>
+    <support name="floor" type="plane"/>
+    <contact name="ball" link="ball" kind="rolling" support="hills" points="2"/>
+    <initial><joint name="root_joint" xyz="0 0 0.5"/></initial>
+  </appell>
+</robot>)";
+  const Scene scene = loadSceneFromString(urdf, ".");
+  ASSERT_EQ(scene.contacts.size(), 2u);
+  EXPECT_EQ(scene.contacts[0]->name(), "ball/p0");
+  EXPECT_EQ(scene.contacts[1]->name(), "ball/p1");
+  EXPECT_NE(scene.contact_origins[1].shape_source.find("point 1"), std::string::npos);
+  auto message = [&](const std::string& from, const std::string& to) {
+    std::string bad = urdf;
+    bad.replace(bad.find(from), from.size(), to);
+    try {
+      loadSceneFromString(bad, ".");
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  const std::string on_plane = message("support=\"hills\" points", "support=\"floor\" points");
+  EXPECT_NE(on_plane.find("<contact name=\"ball\">"), std::string::npos) << on_plane;
+  EXPECT_NE(on_plane.find("more than one point needs a terrain support"), std::string::npos)
+      << on_plane;
+  const std::string five = message("points=\"2\"", "points=\"5\"");
+  EXPECT_NE(five.find("'points' must be a whole number from 1 to 4"), std::string::npos) << five;
 }

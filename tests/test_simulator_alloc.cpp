@@ -368,6 +368,49 @@ TEST(SimulatorAllocation, TerrainFeatureEventsDoNotAllocate) {
   }
 }
 
+// Two points of one pair (ContactSpec::points): a frictionless ball dropped
+// into a V takes turns touching down on the two slopes (the watcher's
+// search past the held piece, the handover at each crossing of the bottom)
+// and comes to rest on both — no allocation in any solver or integrator.
+TEST(SimulatorAllocation, SecondPointTouchdownsDoNotAllocate) {
+  ContactSpec spec;
+  BallOnPlane s = ballOnPlane(spec);
+  spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
+  const double h = 2 * std::tan(M_PI / 6);
+  spec.support = Support{makeTerrain({{-2, -2, h}, {0, -2, 0}, {0, 2, 0}, {-2, 2, h}, {2, -2, h}, {2, 2, h}},
+                                     {{0, 1, 2}, {0, 2, 3}, {1, 4, 5}, {1, 5, 2}}),
+                         StaticMotion{}, "valley", -1};
+  spec.kind = ContactKind::Sliding;
+  spec.points = 2;
+  s.constraints.clear();
+  for (auto& c : makeContactPoints(spec)) s.constraints.push_back(c);
+  VecX q = neutralConfiguration(s.model);
+  q.head<3>() = Vec3(-0.3, 0, 0.8);
+  const VecX v = VecX::Zero(s.model.nv);
+  for (int which = 0; which < 3; ++which) {
+    for (IntegratorType it : {IntegratorType::Leapfrog, IntegratorType::RK4,
+                              IntegratorType::DormandPrince54}) {
+      Simulator sim(s.model, s.constraints, solverNumber(which, s.model, s.constraints), it);
+      ASSERT_TRUE(sim.setState(0, q, v));
+      long allocations = 0, second = 0;
+      while (sim.time() < 2.0) {
+        StepStatus st;
+        {
+          Arm arm;
+          st = sim.step(2e-3);
+          allocations += g_allocations;
+        }
+        ASSERT_TRUE(st.ok) << st.message;
+        for (const ContactEvent& e : sim.events())
+          second += e.kind == ContactEventKind::Touchdown && e.constraint == 1;
+      }
+      EXPECT_GE(second, 3) << "solver " << which << ", " << toString(it);
+      EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
+      EXPECT_TRUE(sim.isClosed(0) && sim.isClosed(1)) << "at rest on both slopes";
+    }
+  }
+}
+
 // The counter works: a step that fails (and builds its message) does allocate.
 TEST(SimulatorAllocation, CounterSeesAllocations) {
   Arm arm;
