@@ -1,6 +1,7 @@
 // What FCL's geometry costs against the analytic contact geometry, per
-// contact evaluation (docs/contacts.md §9), and what a resting box's eight
-// vertex contacts cost per step.
+// contact evaluation (docs/contacts.md §9), what a resting box's eight
+// vertex contacts cost per step, and what a second point of a pair on a
+// terrain (ContactSpec::points, §4) costs per step.
 //
 //   build/bench/bm_collision --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
@@ -139,6 +140,56 @@ void restingStep(benchmark::State& state, bool box) {
     if (!st.ok) state.SkipWithError(st.message.c_str());
   }
 }
+// A ball (or an ellipsoid: the face model) resting on a flat 64 × 64-cell
+// terrain, declared with 1 or 2 points: one RK4 step. The second point is
+// open and watches for a separate piece within its reach every step end
+// (none: the flat patch is one region, which the first point holds).
+void terrainPointsStep(benchmark::State& state) {
+  const bool ellipsoid = state.range(0) == 1;
+  const int points = static_cast<int>(state.range(1));
+  static const Support flat = [] {
+    std::vector<Vec3> v;
+    std::vector<std::array<int, 3>> t;
+    const int n = 64;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) v.emplace_back(-8 + 16.0 * i / n, -8 + 16.0 * j / n, 0.0);
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const int a = j * (n + 1) + i;
+        t.push_back({a, a + 1, a + n + 2});
+        t.push_back({a, a + n + 2, a + n + 1});
+      }
+    return Support{makeTerrain(v, t), StaticMotion{}, "flat"};
+  }();
+  ModelBuilder b;
+  b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
+            principalInertia(1.0, Vec3::Constant(0.004)), "free");
+  const Model model = b.build();
+  ContactSpec spec;
+  spec.kind = ContactKind::Rolling;
+  spec.body = 0;
+  spec.support = flat;
+  spec.points = points;
+  spec.options.name = "c";
+  if (ellipsoid) spec.shape = Ellipsoid{Vec3::Constant(0.1), Vec3::Zero(), Mat3::Identity()};
+  else spec.shape = Sphere{0.1, Vec3::Zero()};
+  ConstraintList constraints;
+  for (auto& c : makeContactPoints(spec)) constraints.push_back(c);
+  VecX q = neutralConfiguration(model);
+  q.head<3>() = Vec3(0.31, 0.22, 0.1);
+  const VecX v = VecX::Zero(model.nv);
+  Simulator sim(model, constraints, makeSolver(Formulation::Tree, model, constraints),
+                IntegratorType::RK4);
+  if (!sim.setState(0, q, v)) state.SkipWithError(sim.lastStateError().c_str());
+  for (auto _ : state) {
+    const StepStatus st = sim.step(1e-3);
+    if (!st.ok) state.SkipWithError(st.message.c_str());
+  }
+  state.SetLabel(std::string(ellipsoid ? "ellipsoid" : "sphere") + ", " + std::to_string(points) +
+                 (points > 1 ? " points" : " point"));
+}
+BENCHMARK(terrainPointsStep)->Name("BM_TerrainPointsStep")->ArgsProduct({{0, 1}, {1, 2}});
+
 void BM_RestingSphereStep(benchmark::State& s) { restingStep(s, false); }
 void BM_RestingBoxStep(benchmark::State& s) { restingStep(s, true); }
 BENCHMARK(BM_RestingSphereStep);

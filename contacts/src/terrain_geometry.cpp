@@ -106,6 +106,12 @@ bool frontSide(const TerrainIndex& idx, int piece, const Vec3& n) {
   return n.dot(idx.vertex_normal[piece - idx.regions - idx.edges]) > 0;
 }
 
+// An edge between two faces of one flat region.
+bool internalEdge(const TerrainIndex& idx, int e) {
+  const auto& f = idx.edge_face[e];
+  return f[1] >= 0 && idx.region[f[0]] == idx.region[f[1]];
+}
+
 // Box of the body in the support frame from its extreme points along the
 // support axes, and half its largest side.
 double bodyBox(const Shape& shape, const SupportState& S, const SE3& pose,
@@ -182,12 +188,21 @@ void separateGeometry(const Shape& shape, const TerrainMesh& t, const SupportSta
             .norm() -
         bound;
     if (!(trial.gap < best_gap) || !(reach < best_gap)) return;
+    // An edge between two faces of one flat region, and a vertex all of whose
+    // edges are such, are never separate (their normal cannot lean out of a
+    // plane on both sides): no solve for them.
     for (int k = 0; k < 3; ++k) {
-      const auto& ends = idx.edge_ends[idx.edge[f][k]];
-      if (terrainEdgeGeometry(shape, t.vertices[ends[0]], t.vertices[ends[1]], S, pose, V, trial,
+      const int e = idx.edge[f][k];
+      const auto& ends = idx.edge_ends[e];
+      if (!internalEdge(idx, e) &&
+          terrainEdgeGeometry(shape, t.vertices[ends[0]], t.vertices[ends[1]], S, pose, V, trial,
                               opt))
         take(idx.edgeFeature(f, k));
-      if (terrainVertexGeometry(shape, t.vertices[idx.weld[tri[k]]], S, pose, V, trial, opt))
+      const int w = idx.weld[tri[k]];
+      bool interior = true;
+      for (int i = idx.vertex_edge_start[w]; i < idx.vertex_edge_start[w + 1] && interior; ++i)
+        interior = internalEdge(idx, idx.vertex_edge[i]);
+      if (!interior && terrainVertexGeometry(shape, t.vertices[w], S, pose, V, trial, opt))
         take(idx.vertexFeature(tri[k]));
     }
   });
