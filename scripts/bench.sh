@@ -35,6 +35,7 @@ declare -A ARGS=(
   [bm_events]="$GB"
   [bm_friction]="$GB"
   [bm_collision]="$GB --benchmark_min_time=0.1"
+  [bm_evaluation]="$GB --benchmark_min_time=0.2"
   [bm_parallel]="$GB"
   [report_speed_error]="--repeats 3 --out $OUT $SPEED_SCENES"
   [report_long_run]="--steps 1000000 --dt 0.01 --out $OUT"
@@ -69,7 +70,7 @@ run() {
   echo "bench.sh: $name done in $(( $(date +%s) - start )) s"
 }
 
-ALL=(bm_dynamics bm_constrained_scaling bm_events bm_friction bm_collision bm_parallel
+ALL=(bm_dynamics bm_evaluation bm_constrained_scaling bm_events bm_friction bm_collision bm_parallel
      report_speed_error report_long_run report_peers thread_scaling)
 total_start=$(date +%s)
 for name in "${@:-${ALL[@]}}"; do run "$name"; done

@@ -94,6 +94,29 @@ sc::BuiltScene cylinderScene(const sc::BuiltScene& thin, double h) {
 /// appell run with the public API (Simulator, makeSolver); `min_axle_z`, if
 /// given, tracks the smallest vertical component of the axle on a 0.05 s grid
 /// (the cylinder's reference must keep resting on the same face).
+// One constrained evaluation of appell's disk at its initial state, as an
+// integrator's stage does it: the rows (evaluateConstraintRows) and the tree
+// solve for v̇ — median over n batches of 2000 calls (CPU s per call).
+double appellEvaluationSeconds(const sc::BuiltScene& s, int n) {
+  appell::ConstraintData cd(s.model, s.constraints, appell::DenseRows::None);
+  appell::Data data(s.model);
+  const auto solver = appell::makeSolver(Formulation::Tree, s.model, s.constraints);
+  const appell::VecX tau = appell::VecX::Zero(s.model.nv);
+  appell::ConstrainedResult res;
+  std::vector<double> batches;
+  const int per = 2000;
+  for (int k = 0; k < n; ++k) {
+    const double t0 = cpuSeconds();
+    for (int i = 0; i < per; ++i) {
+      appell::evaluateConstraintRows(s.model, data, s.constraints, cd, 0.0, s.q0, s.v0);
+      solver->solve(s.model, data, s.constraints, cd, s.q0, s.v0, tau, res,
+                    appell::SolveOutputs::Accelerations);
+    }
+    batches.push_back((cpuSeconds() - t0) / per);
+  }
+  return median(batches);
+}
+
 PeerRun runAppell(const sc::BuiltScene& s, IntegratorType type, const std::string& method, double setting,
                   Formulation form = Formulation::Tree, double* min_axle_z = nullptr) {
   const bool adaptive = type == IntegratorType::DormandPrince54;
@@ -355,7 +378,7 @@ int main(int argc, char** argv) {
   std::map<std::string, const Case*> by_name;
   for (const Case& c : cases) by_name[c.name] = &c;
 
-  std::vector<double> simbody_eval, mujoco_eval;
+  std::vector<double> appell_eval, simbody_eval, mujoco_eval;
   for (int rep = 0; rep < repeats; ++rep) {
     for (Row& r : rows) {
       const Case& c = *by_name[r.case_name];
@@ -374,6 +397,7 @@ int main(int argc, char** argv) {
       r.cpu.push_back(run.cpu);
       r.last = run;
     }
+    appell_eval.push_back(appellEvaluationSeconds(cases[0].disk, 5));
 #ifdef PEERS_HAVE_SIMBODY
     simbody_eval.push_back(simbodyEvaluationSeconds(cases[0].thin, 5));
 #endif
@@ -509,12 +533,16 @@ int main(int argc, char** argv) {
     }
   }
   md << "\n";
-  if (!simbody_eval.empty() || !mujoco_eval.empty()) {
-    md << "One evaluation at the spin case's initial state, median over the repeats of batched calls: ";
+  {
+    md << "One evaluation at the spin case's initial state, median over the repeats of batched calls: "
+       << "appell's rows and tree solve for v̇ (what an integrator stage does): "
+       << fixed(1e6 * median(appell_eval), 3) << " µs; ";
     if (!simbody_eval.empty())
       md << "Simbody `realize(Acceleration)` after a change of q: " << fixed(1e6 * median(simbody_eval), 2)
          << " µs; ";
-    if (!mujoco_eval.empty()) md << "MuJoCo `mj_forward`: " << fixed(1e6 * median(mujoco_eval), 3) << " µs";
+    if (!mujoco_eval.empty())
+      md << "MuJoCo `mj_forward`: " << fixed(1e6 * median(mujoco_eval), 3) << " µs (appell ÷ MuJoCo "
+         << fixed(median(appell_eval) / median(mujoco_eval), 2) << ")";
     md << ". (appell's per-evaluation column above includes its step's share of projection and integrator "
           "work.)\n\n";
   }

@@ -68,6 +68,10 @@ struct Model {
   std::vector<Joint> joints;        ///< joint i connects body i to parent[i]
   std::vector<Inertia> inertias;    ///< body inertia in the body frame
   std::vector<Mat6> spatial_inertia;///< inertias[i].matrix(), cached
+  /// The lower Cholesky factor of each spatial inertia (zero where it is not
+  /// positive definite): a free body without children is its own
+  /// articulated body, and ABA solves with this instead of factorising.
+  std::vector<Mat6> spatial_inertia_factor;
   std::vector<std::string> body_names;
   std::vector<std::string> joint_names;
   std::vector<std::vector<int>> children;

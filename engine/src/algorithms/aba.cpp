@@ -22,6 +22,19 @@ const VecX& aba(const Model& model, Data& data, const VecX& q, const VecX& v, co
   for (int i = model.nbodies - 1; i >= 0; --i) {
     const Joint& j = model.joints[i];
     const int p = model.parent[i];
+    if (j.type == JointType::Floating && p < 0) {
+      // A free root body (S = 1): U = D = I^A, and nothing passes to a
+      // parent, so D⁻¹ is never formed — the forward pass solves with the
+      // Cholesky factor of I^A, kept in Dinv's place (a vector solve, not
+      // a 6 × 6 inverse and three 6 × 6 products). Without children I^A is
+      // the body's own inertia, factorised once in the model.
+      if (model.children[i].empty() && model.spatial_inertia_factor[i](0, 0) > 0)
+        data.Dinv[i] = model.spatial_inertia_factor[i];
+      else
+        data.Dinv[i] = Eigen::LLT<Mat6>(data.IA[i]).matrixL();
+      data.u[i] = tau.segment<6>(j.idx_v) - data.pA[i];
+      continue;
+    }
     Mat6 Ia = data.IA[i];
     Vec6 pa = data.pA[i];
     if (j.nv > 0) {
@@ -56,7 +69,15 @@ const VecX& aba(const Model& model, Data& data, const VecX& q, const VecX& v, co
     Vec6 a = p >= 0 ? Vec6(data.liMi[i].actInv(data.a[p]))
                     : spatial(Vec3::Zero(), -(data.liMi[i].R.transpose() * model.gravity));
     a += data.c[i];
-    if (j.nv > 0) {
+    if (j.type == JointType::Floating && p < 0) {
+      // q̈ = (I^A)⁻¹(u − I^A a) = (I^A)⁻¹u − a, and the body's a + q̈.
+      const Mat6& L = data.Dinv[i];
+      Vec6 x = data.u[i];
+      L.triangularView<Eigen::Lower>().solveInPlace(x);
+      L.transpose().triangularView<Eigen::Upper>().solveInPlace(x);
+      data.ddq.segment<6>(j.idx_v) = x - a;
+      a = x;
+    } else if (j.nv > 0) {
       auto qdd = data.ddq.segment(j.idx_v, j.nv);
       qdd = data.Dinv[i].topLeftCorner(j.nv, j.nv) *
             (data.u[i].head(j.nv) - data.U[i].transpose() * a);

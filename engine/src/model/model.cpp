@@ -4,6 +4,7 @@
 #include <appell/data.hpp>
 #include <appell/dynamics.hpp>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
@@ -228,6 +229,9 @@ Model ModelBuilder::build() const {
     m.joints.push_back(j);
     m.inertias.push_back(e.inertia);
     m.spatial_inertia.push_back(e.inertia.matrix());
+    const Eigen::LLT<Mat6> llt(m.spatial_inertia.back());
+    m.spatial_inertia_factor.push_back(llt.info() == Eigen::Success ? Mat6(llt.matrixL())
+                                                                    : Mat6::Zero());
     m.body_names.push_back(e.name);
     m.joint_names.push_back(e.joint_name);
     if (e.parent >= 0) m.children[e.parent].push_back(i);
