@@ -26,24 +26,27 @@ const Support& ground() {
   return s;
 }
 
-const Support& terrain() {
-  // A 64 × 64 grid of 2 triangles per cell, gently rolling.
-  static const Support s = [] {
-    std::vector<Vec3> v;
-    std::vector<std::array<int, 3>> t;
-    const int n = 64;
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i)
-        v.emplace_back(-8 + 16.0 * i / n, -8 + 16.0 * j / n,
-                       0.05 * std::sin(0.7 * i) * std::cos(0.5 * j));
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const int a = j * (n + 1) + i;
-        t.push_back({a, a + 1, a + n + 2});
-        t.push_back({a, a + n + 2, a + n + 1});
-      }
-    return Support{makeTerrain(v, t), StaticMotion{}, "terrain"};
-  }();
+// A 64 × 64 grid over [−8, 8]², 2 triangles per cell, heights z(i, j).
+template <class Height>
+TerrainMesh grid(Height z) {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  const int n = 64;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) v.emplace_back(-8 + 16.0 * i / n, -8 + 16.0 * j / n, z(i, j));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i;
+      t.push_back({a, a + 1, a + n + 2});
+      t.push_back({a, a + n + 2, a + n + 1});
+    }
+  return makeTerrain(v, t);
+}
+
+const Support& terrain() {  // gently rolling
+  static const Support s{
+      grid([](int i, int j) { return 0.05 * std::sin(0.7 * i) * std::cos(0.5 * j); }),
+      StaticMotion{}, "terrain"};
   return s;
 }
 
@@ -147,20 +150,7 @@ void restingStep(benchmark::State& state, bool box) {
 void terrainPointsStep(benchmark::State& state) {
   const bool ellipsoid = state.range(0) == 1;
   const int points = static_cast<int>(state.range(1));
-  static const Support flat = [] {
-    std::vector<Vec3> v;
-    std::vector<std::array<int, 3>> t;
-    const int n = 64;
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) v.emplace_back(-8 + 16.0 * i / n, -8 + 16.0 * j / n, 0.0);
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const int a = j * (n + 1) + i;
-        t.push_back({a, a + 1, a + n + 2});
-        t.push_back({a, a + n + 2, a + n + 1});
-      }
-    return Support{makeTerrain(v, t), StaticMotion{}, "flat"};
-  }();
+  static const Support flat{grid([](int, int) { return 0.0; }), StaticMotion{}, "flat"};
   ModelBuilder b;
   b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
             principalInertia(1.0, Vec3::Constant(0.004)), "free");

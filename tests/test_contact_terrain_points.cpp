@@ -47,6 +47,18 @@ TerrainMesh bumpy() {
   return makeTerrain(v, f);
 }
 
+// A contact of body 0 (the ball) with `support`.
+ContactSpec ballContact(ContactKind kind, const Shape& shape, const Support& support,
+                        int points = 1) {
+  ContactSpec spec;
+  spec.kind = kind;
+  spec.body = 0;
+  spec.shape = shape;
+  spec.support = support;
+  spec.points = points;
+  return spec;
+}
+
 Model ballModel(double mass, double rho) {
   ModelBuilder b;
   b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
@@ -77,11 +89,7 @@ TEST(ContactTerrainPoints, ABallFallingIntoAPitLandsInsteadOfPassingThroughItsBo
   const double rho = 0.01, mass = 0.05, alpha = 0.3, x0 = 0.001, y0 = 0.0004, z0 = 5;
   const Support ground{pit(alpha), StaticMotion{}, "pit"};
   const Model model = ballModel(mass, rho);
-  ContactSpec spec;
-  spec.kind = ContactKind::Rolling;
-  spec.body = 0;
-  spec.shape = Sphere{rho};
-  spec.support = ground;
+  ContactSpec spec = ballContact(ContactKind::Rolling, Shape{Sphere{rho}}, ground);
   const ConstraintList list{makeContact(spec)};
   VecX q = neutralConfiguration(model);
   q.head<3>() = Vec3(x0, y0, z0);
@@ -114,11 +122,7 @@ TEST(ContactTerrainPoints, ABallFallingOntoARidgeLandsOnItsEdge) {
   for (const Shape& shape : {Shape{Sphere{rho}}, Shape{Ellipsoid{Vec3::Constant(rho)}}}) {
     SCOPED_TRACE(shapeName(shape));
     const Model model = ballModel(mass, rho);
-    ContactSpec spec;
-    spec.kind = ContactKind::Rolling;
-    spec.body = 0;
-    spec.shape = shape;
-    spec.support = roof;
+    ContactSpec spec = ballContact(ContactKind::Rolling, shape, roof);
     const ConstraintList list{makeContact(spec)};
     VecX q = neutralConfiguration(model);
     q.head<3>() = Vec3(x0, 0, z0);
@@ -175,12 +179,7 @@ TEST(ContactTerrainPoints, ABallDroppedIntoAValleyComesToRestOnBothSlopes) {
   for (const Shape& shape : {Shape{Sphere{rho}}, Shape{Ellipsoid{Vec3::Constant(rho)}}}) {
     SCOPED_TRACE(shapeName(shape));
     const Model model = ballModel(mass, rho);
-    ContactSpec spec;
-    spec.kind = ContactKind::Sliding;
-    spec.body = 0;
-    spec.shape = shape;
-    spec.support = valley;
-    spec.points = 2;
+    ContactSpec spec = ballContact(ContactKind::Sliding, shape, valley, 2);
     spec.options.name = "ball";
     const auto points = makeContactPoints(spec);
     ASSERT_EQ(points.size(), 2u);
@@ -247,11 +246,7 @@ TEST(ContactTerrainPoints, ABallBouncesAndRollsOverABumpyMeshWithoutFallingThrou
   q.head<3>() = Vec3(0, 0, 1.1);  // over the grid line y = 0: a ridge below
   VecX v = VecX::Zero(model.nv);
   v[3] = 2;
-  ContactSpec spec;
-  spec.kind = ContactKind::Rolling;
-  spec.body = 0;
-  spec.shape = Sphere{rho};
-  spec.support = ground;
+  ContactSpec spec = ballContact(ContactKind::Rolling, Shape{Sphere{rho}}, ground);
   spec.mu = 0.8;
   spec.restitution = 0.6;
   const ConstraintList list{makeContact(spec)};
@@ -297,11 +292,7 @@ TEST(ContactTerrainPoints, OneAndTwoPointsRollTheSameBallOverABumpyMesh) {
   double loss[2];
   for (int points : {1, 2}) {
     SCOPED_TRACE(points);
-    ContactSpec spec;
-    spec.kind = ContactKind::Rolling;
-    spec.body = 0;
-    spec.shape = Sphere{rho};
-    spec.support = ground;
+    ContactSpec spec = ballContact(ContactKind::Rolling, Shape{Sphere{rho}}, ground);
     spec.mu = 0.8;
     spec.restitution = 0.6;
     spec.points = points;
@@ -324,11 +315,8 @@ TEST(ContactTerrainPoints, OneAndTwoPointsRollTheSameBallOverABumpyMesh) {
 // on a support other than a terrain, or on a bilateral contact, are errors
 // naming the contact.
 TEST(ContactTerrainPoints, BadPointCountsAreRefusedNamingTheContact) {
-  ContactSpec spec;
-  spec.kind = ContactKind::Rolling;
-  spec.body = 0;
-  spec.shape = Sphere{0.1};
-  spec.support = Support{trough(0.3), StaticMotion{}, "valley"};
+  ContactSpec spec = ballContact(ContactKind::Rolling, Shape{Sphere{0.1}},
+                                 Support{trough(0.3), StaticMotion{}, "valley"});
   spec.options.name = "wheel";
   using appell::test::invalidArgumentMessage;
   spec.points = 5;
