@@ -377,3 +377,51 @@ TEST(ContactTerrainPoints, TheSceneFormatDeclaresPointsAndRefusesBadOnes) {
   const std::string five = message("points=\"2\"", "points=\"5\"");
   EXPECT_NE(five.find("'points' must be a whole number from 1 to 4"), std::string::npos) << five;
 }
+
+// Protects a rolling ball's handovers between two points (examples/
+// ball_gutter). A ball rolling along a V gutter (slopes ±α, α = atan 3/8)
+// from rest across it on one slope rolls down with acceleration
+// (5/7) g sin α, reaches the bottom after √(2 d/((5/7) g sin α)), d = 0.5/cos α,
+// and the second point touches down on the other slope. The plastic rolling
+// impact keeps the angular momentum about the new contact point:
+//   I u/ρ + m ρ u cos 2α = I u′/ρ + m ρ u′   ⇒   u′/u = (2/5 + cos 2α)/(7/5)
+// of the speed across (the first point lifts off), and the ball rolls up
+// the other slope and back in 2u′/((5/7) g sin α). The points take turns;
+// the touchdown speeds (−u sin 2α) follow to 1e-9 and the times to 1e-8
+// (after ~40 events), the sequence ends, and the ball rolls on along the
+// bottom on both walls, centred.
+TEST(ContactTerrainPoints, TheGutterExampleHandsOverBetweenItsPointsAsAngularMomentumSays) {
+  const Scene scene = loadScene(APPELL_SOURCE_DIR "/examples/ball_gutter/ball_gutter.urdf");
+  ASSERT_EQ(scene.contacts.size(), 2u);
+  const double alpha = std::atan(0.375), rho = 0.1;
+  const double acc = 5.0 / 7.0 * kG * std::sin(alpha);
+  const double keep = (0.4 + std::cos(2 * alpha)) / 1.4;
+  Simulator sim(scene.model, scene.constraints,
+                makeSolver(Formulation::Tree, scene.model, scene.constraints),
+                IntegratorType::DormandPrince54, appell::test::tightIntegrator());
+  ASSERT_TRUE(sim.setState(0, scene.q0, scene.v0)) << sim.lastStateError();
+  ASSERT_TRUE(sim.isClosed(0));
+  ASSERT_FALSE(sim.isClosed(1));
+  const auto run = appell::test::runWatching(sim, 9.0, [](const Simulator&) { return 0.0; }, 0.05);
+  std::vector<ContactEvent> touchdowns;
+  for (const ContactEvent& e : run.modeEvents())
+    if (e.kind == ContactEventKind::Touchdown) touchdowns.push_back(e);
+  ASSERT_GE(touchdowns.size(), 20u);
+  EXPECT_LT(touchdowns.size(), 60u) << "the sequence ends";
+  double t = std::sqrt(2 * (0.5 / std::cos(alpha)) / acc), u = acc * t;
+  for (size_t k = 0; k < touchdowns.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(touchdowns[k].constraint, static_cast<int>((k + 1) % 2)) << "the points take turns";
+    EXPECT_NEAR(touchdowns[k].t, t, 1e-8);
+    if (u * std::sin(2 * alpha) > 2e-3) {
+      EXPECT_NEAR(touchdowns[k].speed_before, -u * std::sin(2 * alpha), 1e-9);
+    }
+    u *= keep;
+    t += 2 * u / acc;
+  }
+  EXPECT_TRUE(sim.isClosed(0) && sim.isClosed(1)) << "rolling on both walls";
+  EXPECT_NEAR(sim.q()[0], 0, 1e-9);
+  EXPECT_NEAR(sim.q()[2], rho / std::cos(alpha), 1e-9);
+  EXPECT_GT(sim.q()[1], 5.0) << "still rolling along the gutter";
+  EXPECT_LT(run.worst_energy, 1e-8);
+}

@@ -269,7 +269,8 @@ TEST_P(ExampleEvents, RunListsTheEventsAndWritesARowForEach) {
 INSTANTIATE_TEST_SUITE_P(
     EventExamples, ExampleEvents,
     ::testing::Values(EventCase{"bouncing_ball/bouncing_ball.urdf", "floor_contact", 18, 18},
-                      EventCase{"rimless_wheel/rimless_wheel.urdf", "foot1_l", 28, 7}),
+                      EventCase{"rimless_wheel/rimless_wheel.urdf", "foot1_l", 28, 7},
+                      EventCase{"ball_gutter/ball_gutter.urdf", "walls/p0", 6, 3}),
     [](const ::testing::TestParamInfo<EventCase>& p) {
       std::string n = p.param.file;
       n = n.substr(n.find('/') + 1);
