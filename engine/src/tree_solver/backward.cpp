@@ -249,6 +249,11 @@ bool splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& 
   if (nd.nf > 0) {
     nd.U.noalias() = nd.IA * nd.S2;
     const SmallMat D = nd.S2.transpose() * nd.U;
+    if (root) {  // H, GK and IaS only serve the parent; D⁻¹ only the forward pass
+      nd.Dinv = D.llt().matrixL();
+      nd.dinv_factor = true;
+      return true;
+    }
     nd.Dinv = D.llt().solve(SmallMat::Identity(nd.nf, nd.nf));
   }
   if (root) return true;  // H, GK and IaS only serve the parent
@@ -352,6 +357,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       if (closed > 1) ws.redundant += closed - 1;  // one row on q̈, split by min norm
     }
     const bool soft_rows = nd.ncomp > 0 && nd.comp[nd.ncomp - 1].soft;
+    nd.dinv_factor = false;
     if (nd.locked)
       splitLocked(ws, j, p < 0, nd, H);
     else if (soft_rows || !(j.nv == 1 ? splitOneDof(o, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))

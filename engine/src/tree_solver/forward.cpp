@@ -83,7 +83,14 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
     if (nd.nf > 0) {
       KVec z = nd.u;
       z.noalias() -= nd.U.transpose() * w;
-      const KVec zz = nd.Dinv * z;
+      KVec zz;
+      if (nd.dinv_factor) {
+        zz = z;
+        nd.Dinv.triangularView<Eigen::Lower>().solveInPlace(zz);
+        nd.Dinv.transpose().triangularView<Eigen::Upper>().solveInPlace(zz);
+      } else {
+        zz.noalias() = nd.Dinv * z;
+      }
       a.noalias() += nd.S2 * zz;
       if (nd.rankG > 0)
         qdd.noalias() += nd.V2 * zz;

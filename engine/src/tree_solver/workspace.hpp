@@ -188,7 +188,11 @@ struct Node {
   SmallMat U2;                            ///< nK × npass (U2Form::Explicit)
   SmallMat V2;                            ///< nv × nf, right null space of K S
   Mat6X S2, U;                            ///< S V2 and IA S V2
-  SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹
+  SmallMat Dinv;                          ///< (S2ᵀ IA S2)⁻¹, or its lower Cholesky factor (dinv_factor)
+  /// Dinv holds the Cholesky factor L of D (a root's general split: nothing
+  /// passes to a parent, so D⁻¹ is only applied to the forward pass's one
+  /// vector — two triangular solves instead of forming the inverse).
+  bool dinv_factor = false;
   KVec u;                                 ///< V2ᵀ τ − S2ᵀ pA
 
   // Compliant elimination (tree_solver/soft.cpp): the joint is eliminated as
