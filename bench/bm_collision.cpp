@@ -110,6 +110,19 @@ BENCHMARK(BM_AnalyticEllipsoidOnTerrain);
 BENCHMARK(BM_FclSphereOnTerrain);
 BENCHMARK(BM_FclBoxOnTerrain);
 
+// One RK4 step (h = 1e-3, tree solver) per iteration of a body started at
+// rest at q.
+void timeRestingSteps(benchmark::State& state, const Model& model,
+                      const ConstraintList& constraints, const VecX& q) {
+  Simulator sim(model, constraints, makeSolver(Formulation::Tree, model, constraints),
+                IntegratorType::RK4);
+  if (!sim.setState(0, q, VecX::Zero(model.nv))) state.SkipWithError(sim.lastStateError().c_str());
+  for (auto _ : state) {
+    const StepStatus st = sim.step(1e-3);
+    if (!st.ok) state.SkipWithError(st.message.c_str());
+  }
+}
+
 // A box resting on its four lower corners (8 vertex contacts, 4 closed with
 // 3 rows each, redundant): one RK4 step, against a sphere resting on one
 // rolling contact — what a non-smooth body at rest costs per step.
@@ -134,14 +147,7 @@ void restingStep(benchmark::State& state, bool box) {
   }
   VecX q = neutralConfiguration(model);
   q[2] = z;
-  const VecX v = VecX::Zero(model.nv);
-  Simulator sim(model, constraints, makeSolver(Formulation::Tree, model, constraints),
-                IntegratorType::RK4);
-  if (!sim.setState(0, q, v)) state.SkipWithError(sim.lastStateError().c_str());
-  for (auto _ : state) {
-    const StepStatus st = sim.step(1e-3);
-    if (!st.ok) state.SkipWithError(st.message.c_str());
-  }
+  timeRestingSteps(state, model, constraints, q);
 }
 // A ball (or an ellipsoid: the face model) resting on a flat 64 × 64-cell
 // terrain, declared with 1 or 2 points: one RK4 step. The second point is
@@ -167,14 +173,7 @@ void terrainPointsStep(benchmark::State& state) {
   for (auto& c : makeContactPoints(spec)) constraints.push_back(c);
   VecX q = neutralConfiguration(model);
   q.head<3>() = Vec3(0.31, 0.22, 0.1);
-  const VecX v = VecX::Zero(model.nv);
-  Simulator sim(model, constraints, makeSolver(Formulation::Tree, model, constraints),
-                IntegratorType::RK4);
-  if (!sim.setState(0, q, v)) state.SkipWithError(sim.lastStateError().c_str());
-  for (auto _ : state) {
-    const StepStatus st = sim.step(1e-3);
-    if (!st.ok) state.SkipWithError(st.message.c_str());
-  }
+  timeRestingSteps(state, model, constraints, q);
   state.SetLabel(std::string(ellipsoid ? "ellipsoid" : "sphere") + ", " + std::to_string(points) +
                  (points > 1 ? " points" : " point"));
 }
