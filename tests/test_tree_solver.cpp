@@ -4,6 +4,7 @@
 // on random trees with every joint type, fixed and
 // floating base, 1–6 rows per body, duplicated and scaled rows, rows a joint
 // cannot move, and singular poses; inconsistent rows give an error naming them.
+#include "dense_reference.hpp"
 #include "tree_solver_common.hpp"
 
 #include <gtest/gtest.h>

@@ -6,6 +6,7 @@
 // ones, two rows on one joint, rows redundant with a body row — and the
 // M-metric velocity projection; the rows are never loop rows, so a limit on
 // every joint costs O(1) each; disagreeing rows on one joint are named.
+#include "dense_reference.hpp"
 #include "tree_solver_common.hpp"
 
 #include <appell/joint_coupling.hpp>

@@ -5,6 +5,7 @@
 // and the minimum-norm λ agree with the long-double Udwadia–Kalaba reference
 // and the dense KKT solver to 1e-10, the rank agrees, and the projection
 // itself agrees with the dense one.
+#include "dense_reference.hpp"
 #include "tree_solver_common.hpp"
 
 #include "car_row.hpp"

@@ -1,8 +1,6 @@
 // Shared pieces of the tree-solver tests: test-only constraints with random
-// body-local rows, consistent right sides, and the dense Udwadia–Kalaba
-// reference (Udwadia & Kalaba, Proc. R. Soc. Lond. A 439, 1992):
-//   v̇ = a + M^{-½}(A M^{-½})⁺(c − A a),  a = M⁻¹(τ − h),  c = −abias,
-//   λ_min = (Aᵀ)⁺(M v̇ + h − τ).
+// body-local rows, consistent right sides, random systems (the dense
+// references they are checked against: dense_reference.hpp).
 #pragma once
 
 #include <appell/appell.hpp>
@@ -100,24 +98,6 @@ ConstrainedResult treeSolve(const System& s);
 /// of A at s's state: redundant with the tree rows (a loop row they make
 /// immobile).
 void addJointCopyOfLastRow(System& s, const std::string& name, double scale);
-
-/// Pseudo-inverse solve with a relative singular-value threshold.
-VecX pinvSolve(const MatX& A, const VecX& b, double rel = 1e-10);
-
-struct Reference {
-  VecX vdot, lambda, reaction;
-  int rank = 0;
-};
-
-/// Udwadia–Kalaba with the symmetric square root of M, evaluated in long
-/// double so that the reference is not the least accurate party (the tree
-/// solver is often more accurate than the same formula in double).
-Reference denseReference(const Model& model, const ConstraintData& cd, const VecX& q,
-                         const VecX& v, const VecX& tau);
-
-/// Dense M-metric projection v⁺ = v + M^{-½}(A M^{-½})⁺(−b − A v).
-VecX denseProjection(const Model& model, const ConstraintData& cd, const VecX& q,
-                     const VecX& v);
 
 struct RowRecipe {
   double p_duplicate = 0.0;   ///< row = scale × an earlier row of the same body
