@@ -305,7 +305,13 @@ TEST(ContactTerrain, BallPivotsAboutTheCreaseAndLiftsOffWhereTheoryPredicts) {
       EXPECT_LT(phi_star, kSlope) << "before the ramp could take over";
       EXPECT_EQ(events[1].kind, ContactEventKind::Touchdown) << "lands on the ramp";
     } else {
-      EXPECT_TRUE(events.empty()) << "a slow ball pivots through the crease in contact";
+      // In contact throughout: no lift-off, and no impact beyond the
+      // precision of the change of piece onto the ramp (located where the
+      // normal leans past the face by ~1e-9, so the ball may meet the face
+      // at ~v₀·1e-8 m/s: a touchdown with nothing to absorb).
+      for (const ContactEvent& e : events)
+        EXPECT_TRUE(e.kind == ContactEventKind::Touchdown && std::abs(e.speed_before) < 1e-8)
+            << "a slow ball pivots through the crease in contact (event at t = " << e.t << ")";
       EXPECT_GT(sim.q()[0], 0.3) << "and rolls on down the ramp";
     }
     // Its changes of piece are located events: onto the edge when its
@@ -316,7 +322,7 @@ TEST(ContactTerrain, BallPivotsAboutTheCreaseAndLiftsOffWhereTheoryPredicts) {
     EXPECT_NEAR(pieces[0].t, 0.2 / v0, 1e-11) << "onto the edge";
     EXPECT_NEAR(run.at_event[0], 0, 1e-11);
     if (v0 < 0.9) {
-      EXPECT_NEAR(run.at_event.back(), kSlope, 1e-8) << "onto the ramp";
+      EXPECT_NEAR(run.at_event.back(), kSlope, 2e-8) << "onto the ramp";
     }
   }
 }

@@ -456,3 +456,47 @@ TEST(TreeSolver, InconsistentLoopRowsAreAnErrorNamingThem) {
     EXPECT_EQ(error.find("'other'"), std::string::npos) << error;
   }
 }
+
+// One body on a floating joint (a ball, a disk, a top) is solved in closed
+// form (tree_solver/free_body.cpp) when its rows are resolved whole; redundant
+// or weak rows go to the passes. Both must give the passes' answer: v̇, λ and
+// Aᵀλ to round-off, and the velocity projection too — and the closed form
+// must actually be taken for the well-posed cases (else this tests nothing).
+TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
+  std::mt19937 rng(31);
+  SolverOptions passes_only;
+  passes_only.free_body_closed_form = false;
+  int closed = 0, fallback = 0;
+  for (int rep = 0; rep < 300; ++rep) {
+    // One constraint of 1–6 rows, sometimes with duplicates (redundant: the passes).
+    System s = randomSystem(1, true, rng, RowRecipe{rep % 3 == 0 ? 0.3 : 0.0, 0.0, 1});
+    const ConstraintList list = s.list();
+    Data data(s.model);
+    ConstraintData cd(s.model, list);
+    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+    TreeSolver fast(s.model, list), slow(s.model, list, passes_only);
+    ConstrainedResult a, b;
+    fast.solve(s.model, data, list, cd, s.q, s.v, s.tau, a);
+    slow.solve(s.model, data, list, cd, s.q, s.v, s.tau, b);
+    ASSERT_TRUE(a.ok && b.ok) << a.error << b.error;
+    EXPECT_FALSE(slow.lastSolveClosedForm());
+    (fast.lastSolveClosedForm() ? closed : fallback)++;
+    EXPECT_LT(relErr(a.vdot, b.vdot), 1e-11) << "rep " << rep;
+    EXPECT_LT(relErr(a.lambda, b.lambda), 1e-11) << "rep " << rep;
+    EXPECT_LT(relErr(a.reaction, b.reaction), 1e-11) << "rep " << rep;
+    EXPECT_EQ(a.rank, b.rank);
+    if (fast.lastSolveClosedForm()) {
+      const Reference ref = denseReference(s.model, cd, s.q, s.v, s.tau);
+      EXPECT_LT(relErr(a.vdot, ref.vdot), 1e-10) << "rep " << rep;
+      EXPECT_LT(relErr(a.lambda, ref.lambda), 1e-10) << "rep " << rep;
+      EXPECT_EQ(a.redundant, 0);
+    }
+    VecX va = s.v, vb = s.v, ma, mb;
+    ASSERT_TRUE(fast.projectVelocity(s.model, data, list, cd, s.q, va, ma)) << fast.lastError();
+    ASSERT_TRUE(slow.projectVelocity(s.model, data, list, cd, s.q, vb, mb)) << slow.lastError();
+    EXPECT_LT(relErr(va, vb), 1e-11) << "rep " << rep;
+    EXPECT_LT(relErr(ma, mb), 1e-11) << "rep " << rep;
+  }
+  EXPECT_GT(closed, 100);
+  EXPECT_GT(fallback, 20);
+}

@@ -39,6 +39,10 @@ struct SolverOptions {
   double rank_abs_tol = 1e-10;   ///< absolute rank tolerance on equilibrated rows
   double rank_rel_tol = 1e-10;   ///< relative rank tolerance
   double consistency_tol = 1e-8; ///< residual above which redundant rows are inconsistent
+  /// Tree solver: a model of one body on a floating joint, its rows resolved
+  /// whole, is solved in closed form (tree_solver/free_body.cpp); false runs
+  /// the general passes there too (the tests compare the two).
+  bool free_body_closed_form = true;
 };
 
 /// What a solve must produce. Integrator stages need only v̇; reports need λ.

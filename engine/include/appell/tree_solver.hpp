@@ -68,6 +68,9 @@ class TreeSolver : public ConstrainedSolver {
   /// Rows found redundant (or zero) by the last solve or projectVelocity:
   /// the rank of the active rows is m_active minus this.
   int redundantRows() const;
+  /// Whether the last solve or projection took the one-free-body closed form
+  /// (tree_solver/free_body.cpp) rather than the passes.
+  bool lastSolveClosedForm() const;
   const std::string& lastError() const override;
 
  private:

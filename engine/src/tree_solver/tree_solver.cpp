@@ -80,6 +80,14 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   }
   ws.m = global;
   std::sort(ws.jrow_nodes.begin(), ws.jrow_nodes.end());
+  // One free body (tree_solver/free_body.cpp) with a positive definite
+  // inertia: L⁻¹ of its constant factor I = L Lᵀ, formed once.
+  ws.free_body = options.free_body_closed_form && model.nbodies == 1 &&
+                 model.joints[0].type == JointType::Floating && ws.loops.empty() &&
+                 ws.jrow_nodes.empty() && model.spatial_inertia_factor[0](0, 0) > 0;
+  if (ws.free_body)
+    ws.free_body_linv = model.spatial_inertia_factor[0].triangularView<Eigen::Lower>().solve(
+        Mat6::Identity());
   for (int i = 0; i < model.nbodies; ++i)
     for (int ch : model.children[i]) ws.nodes[i].groups.push_back({Segment::Child, ch, 0});
   for (auto& nd : ws.nodes) {
@@ -129,6 +137,7 @@ TreeSolver::~TreeSolver() = default;
 
 int TreeSolver::loopRows() const { return static_cast<int>(ws_->loops.size()); }
 int TreeSolver::redundantRows() const { return ws_->last_redundant; }
+bool TreeSolver::lastSolveClosedForm() const { return ws_->last_closed_form; }
 const std::string& TreeSolver::lastError() const { return ws_->last_error; }
 
 namespace {
@@ -170,6 +179,21 @@ void velocityTerms(const Model& model, const Data& data, const VecX& v, detail::
   }
 }
 
+/// The outputs of a dynamics solve from the workspace: v̇, the rank, and
+/// (unless only v̇ is asked for) the minimum-norm λ and the reaction Aᵀλ.
+void finish(const Model& model, const Data& data, const ConstraintData& cdata,
+            detail::TreeWorkspace& ws, int zero_rows, ConstrainedResult& out,
+            SolveOutputs outputs) {
+  out.vdot = ws.vdot;
+  out.redundant = ws.redundant - zero_rows;
+  ws.last_redundant = out.redundant;
+  out.rank = cdata.m_active - out.redundant;
+  if (outputs == SolveOutputs::Accelerations) return;  // an integrator stage: v̇ is all it reads
+  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);  // zero rows too: their λ = 0
+  out.lambda = ws.lambda;
+  detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
+}
+
 }  // namespace
 
 void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& constraints,
@@ -187,6 +211,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   out.ok = true;
   out.error.clear();
   ws.last_error.clear();
+  ws.last_closed_form = false;
   if (cdata.singular) {
     out.ok = false;
     out.error = "singular constraint geometry: " + cdata.singular_reason;
@@ -195,8 +220,6 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   }
 
   forwardKinematics(model, data, q, v);
-  velocityTerms(model, data, v, ws);
-  detail::factorPass(model, data, cdata, ws);
   // Right sides on the gravity-shifted accelerations a' = a − g (ABA's trick):
   // w·a + κ = 0  ⇔  w·a' = −κ − w_lin·g.
   for (auto& tb : ws.blocks) {
@@ -209,6 +232,13 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     for (auto& jr : ws.nodes[b].jrows) jr.rhs = -cdata.blocks[jr.constraint].abias_joint[jr.row];
   ws.tau = tau;
   ws.a_world = spatial(Vec3::Zero(), -model.gravity);
+  ws.last_closed_form = ws.free_body && detail::freeBodySolve(model, data, cdata, ws, false);
+  if (ws.last_closed_form) {
+    finish(model, data, cdata, ws, zero_rows, out, outputs);
+    return;
+  }
+  velocityTerms(model, data, v, ws);
+  detail::factorPass(model, data, cdata, ws);
   ws.use_c = true;
   ws.lambda.setZero();
   detail::loopTargets(model, data, cdata, ws, v, false);
@@ -220,14 +250,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     return;
   }
   ws.redundant += static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank;
-  out.vdot = ws.vdot;
-  out.redundant = ws.redundant - zero_rows;
-  ws.last_redundant = out.redundant;
-  out.rank = cdata.m_active - out.redundant;
-  if (outputs == SolveOutputs::Accelerations) return;  // an integrator stage: v̇ is all it reads
-  if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);  // zero rows too: their λ = 0
-  out.lambda = ws.lambda;
-  detail::reactionForces(model, data, cdata, ws, ws.lambda, out.reaction);
+  finish(model, data, cdata, ws, zero_rows, out, outputs);
 }
 
 bool TreeSolver::projectVelocity(const Model& model, Data& data, const ConstraintList& constraints,
@@ -238,6 +261,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
   int zero_rows = 0;
   const int open_loops = applyActiveSet(cdata, ws, zero_rows);
   ws.last_error.clear();
+  ws.last_closed_form = false;
   if (cdata.singular) {
     ws.last_error = "singular constraint geometry: " + cdata.singular_reason;
     return false;
@@ -247,8 +271,6 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
   // min ½‖Δ‖²_M  s.t.  A Δ = −(A v + b): the dynamics problem with no forces,
   // no velocity products, no gravity, and the velocity residual as right side.
   forwardKinematics(model, data, q, v);
-  detail::factorPass(model, data, cdata, ws);
-  for (auto& nd : ws.nodes) nd.bias0.setZero();
   for (auto& tb : ws.blocks) {
     const RowBlock& blk = cdata.blocks[tb.constraint];
     const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
@@ -262,15 +284,20 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     }
   ws.tau.setZero();
   ws.a_world.setZero();
-  ws.use_c = false;
-  ws.lambda.setZero();
-  detail::loopTargets(model, data, cdata, ws, v, true);
-  if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||
-      !detail::solveLoops(model, data, cdata, ws)) {
-    ws.last_error = detail::describeFailure(model, data, ws);
-    return false;
+  ws.last_closed_form = ws.free_body && detail::freeBodySolve(model, data, cdata, ws, true);
+  if (!ws.last_closed_form) {
+    detail::factorPass(model, data, cdata, ws);
+    for (auto& nd : ws.nodes) nd.bias0.setZero();
+    ws.use_c = false;
+    ws.lambda.setZero();
+    detail::loopTargets(model, data, cdata, ws, v, true);
+    if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||
+        !detail::solveLoops(model, data, cdata, ws)) {
+      ws.last_error = detail::describeFailure(model, data, ws);
+      return false;
+    }
+    ws.redundant += static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank;
   }
-  ws.redundant += static_cast<int>(ws.loops.size()) - open_loops - ws.loop_rank;
   ws.last_redundant = ws.redundant - zero_rows;
   if (ws.redundant > 0) detail::minimumNorm(model, ws, ws.lambda);
   v += ws.vdot;

@@ -272,6 +272,9 @@ struct TreeWorkspace {
   std::vector<LoopRow> loops;
   std::vector<int> jrow_nodes;            ///< bodies with JointRows, ascending
   std::vector<std::string> names;         ///< constraint names, for messages
+  bool free_body = false;                 ///< one body on a floating joint, no loop or joint rows (free_body.cpp)
+  bool last_closed_form = false;          ///< the last solve took free_body.cpp's closed form
+  Mat6 free_body_linv;                    ///< L⁻¹, I = L Lᵀ the free body's inertia (body frame)
 
   // Solver scratch with compile-time maximum sizes.
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
@@ -397,6 +400,14 @@ void softForward(const Joint& j, Node& nd, const Vec6& abar, VecX& vdot);
 /// tree rows and the loop closure's redundant directions. Nothing to do when
 /// no row is redundant.
 void minimumNorm(const Model& model, TreeWorkspace& ws, VecX& lambda);
+
+/// The one-free-body solve in closed form (tree_solver/free_body.cpp):
+/// v̇ (or the velocity change, `impulse`) into ws.vdot and λ into ws.lambda,
+/// from the blocks' right sides, ws.tau and ws.a_world. False, having
+/// changed nothing the passes read, when the rows are not resolved whole
+/// (redundant, weak, zero or more than 6 rows): then the passes solve.
+bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& cdata,
+                   TreeWorkspace& ws, bool impulse);
 /// "…" message naming the constraints involved in the inconsistency of ws.failure.
 std::string describeFailure(const Model& model, const Data& data, TreeWorkspace& ws);
 

@@ -1,0 +1,148 @@
+// Tree solver, the one-free-body case (a ball, a disk, a top, an ellipsoid:
+// a model that is one body on a floating joint, every row its own). There
+// Gauss' principle is one rigid body's, solved in closed form:
+//   I a = f₀ + Kᵀ μ,   K a = k,   f₀ = τ − v ×* I v,
+//   a₀ = I⁻¹ f₀,   (K I⁻¹ Kᵀ) μ = k − K a₀,   a = a₀ + I⁻¹ Kᵀ μ,
+// with I = L Lᵀ (Model::spatial_inertia_factor) and Y = L⁻¹ Kᵀ, so that
+// K I⁻¹ Kᵀ = Yᵀ Y and a = L⁻ᵀ(L⁻¹ f₀ + Y μ). I is constant in the body's
+// frame, so L⁻¹ is formed once (TreeSolver's constructor) and every solve is
+// fixed-size 6 × 6 products plus an m × m Cholesky (m ≤ 6 rows, stored padded
+// with zero rows): the general passes' answer without their dynamic-size
+// machinery (compression, split, articulated inertia) and without the
+// division chains of triangular solves.
+//
+// It is taken only where it is that answer. The rows, equilibrated (E K),
+// must be resolved whole by the free joint, which the general passes decide
+// by σ_min(E K) ≥ 1/‖R⁻¹‖_F > kWeakPivot on the compression's triangular
+// factor (backward.cpp, freeSplit); here the same bound is taken on the
+// Cholesky factor of the rows' Gram matrix, E K Kᵀ E = Lg Lgᵀ (Lg is the LQ
+// factor of E K, so σ(E K) = σ(Lg)). Then no row is redundant, μ is unique,
+// and the result agrees with the passes to round-off (tests/test_tree_solver.cpp,
+// FreeBody…). Anything else — redundant or weak rows, sliding contacts'
+// friction rows (zero rows), more than 6 rows — goes to the passes.
+#include "tree_solver/workspace.hpp"
+
+#include <cmath>
+
+namespace appell::detail {
+
+namespace {
+
+/// In-place Cholesky of the leading n × n of a (lower triangle read and
+/// overwritten by L); inv gets 1/L_jj. False when a pivot is not positive.
+bool cholesky(Mat6& a, int n, double inv[6]) {
+  for (int j = 0; j < n; ++j) {
+    double d = a(j, j);
+    for (int k = 0; k < j; ++k) d -= a(j, k) * a(j, k);
+    if (!(d > 0)) return false;
+    a(j, j) = std::sqrt(d);
+    inv[j] = 1.0 / a(j, j);
+    for (int i = j + 1; i < n; ++i) {
+      double s = a(i, j);
+      for (int k = 0; k < j; ++k) s -= a(i, k) * a(j, k);
+      a(i, j) = s * inv[j];
+    }
+  }
+  return true;
+}
+
+/// x ← L⁻¹ x, then x ← L⁻ᵀ x, for a lower-triangular n × n factor.
+void choleskySolve(const Mat6& l, const double inv[6], int n, double* x) {
+  for (int i = 0; i < n; ++i) {
+    double s = x[i];
+    for (int k = 0; k < i; ++k) s -= l(i, k) * x[k];
+    x[i] = s * inv[i];
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    double s = x[i];
+    for (int k = i + 1; k < n; ++k) s -= l(k, i) * x[k];
+    x[i] = s * inv[i];
+  }
+}
+
+/// 1/‖L⁻¹‖_F, a lower bound on σ_min(L).
+double sigmaMinBound(const Mat6& l, const double inv[6], int n) {
+  double fro = 0;
+  for (int c = 0; c < n; ++c) {
+    double x[6] = {};
+    x[c] = inv[c];
+    fro += x[c] * x[c];
+    for (int r = c + 1; r < n; ++r) {
+      double s = 0;
+      for (int k = c; k < r; ++k) s -= l(r, k) * x[k];
+      x[r] = s * inv[r];
+      fro += x[r] * x[r];
+    }
+  }
+  return 1.0 / std::sqrt(fro);
+}
+
+}  // namespace
+
+bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& cdata,
+                   TreeWorkspace& ws, bool impulse) {
+  // The rows in the body frame, equilibrated, as the columns of Kt = (E K)ᵀ
+  // (zero past the m-th); k_e = E k.
+  Mat6 Kt = Mat6::Zero();
+  double k[6], e[6];
+  int global[6];
+  int m = 0;
+  const SE3& oMi = data.oMi[0];
+  for (const TreeBlock& tb : ws.blocks) {
+    if (tb.rows == 0) continue;
+    if (cdata.isSliding(tb.constraint) || m + tb.rows > 6) return false;
+    const RowBlock& blk = cdata.blocks[tb.constraint];
+    const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
+    for (int r = 0; r < tb.rows; ++r, ++m) {
+      const Vec6 w = oMi.actInvForce(tb.sign * Eigen::Map<const Vec6>(W.data() + 6 * r));
+      const double n = w.norm();
+      if (!(n > ws.options.rank_abs_tol)) return false;  // a zero row: the passes drop it
+      e[m] = 1.0 / n;
+      Kt.col(m) = e[m] * w;
+      k[m] = e[m] * tb.rhs[r];
+      global[m] = tb.global + r;
+    }
+  }
+
+  // Resolved whole? The Gram matrix's factor bounds σ_min(E K) from below.
+  double inv[6];
+  if (m > 0) {
+    Mat6 G;  // the leading m × m only: the factorisation reads no more
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j <= i; ++j) G(i, j) = Kt.col(i).dot(Kt.col(j));
+    if (!cholesky(G, m, inv) || !(sigmaMinBound(G, inv, m) > kWeakPivot)) return false;
+  }
+
+  // z = L⁻¹ f₀, Y = L⁻¹ Kt, S = Yᵀ Y = E K I⁻¹ Kᵀ E, r = k_e − Yᵀ z (= k_e − E K a₀).
+  const Mat6& Linv = ws.free_body_linv;
+  Vec6 z = Vec6::Zero();
+  if (!impulse) {
+    const Vec6& v = data.v[0];
+    z.noalias() = Linv * (ws.tau.head<6>() - crossForce(v, model.spatial_inertia[0] * v));
+  }
+  Mat6 Y, S;
+  Y.noalias() = Linv * Kt;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j <= i; ++j) S(i, j) = Y.col(i).dot(Y.col(j));
+  Vec6 r = Vec6::Zero();
+  r.head(m) = Eigen::Map<const Vec6>(k).head(m);
+  r.noalias() -= Y.transpose() * z;  // entries past m: 0 − 0
+  if (m > 0) {
+    if (!cholesky(S, m, inv)) return false;
+    choleskySolve(S, inv, m, r.data());  // r = μ_e
+  }
+
+  // a = L⁻ᵀ(z + Y μ_e); λ = E μ_e (the force on the body is K_eᵀ μ_e = Kᵀ E μ_e).
+  z.noalias() += Y * r;
+  const Vec6 a = Linv.transpose() * z;
+  // Gravity-shifted (ABA's trick): q̈ = a − ᵖXᵢ a_world; a free joint's
+  // velocity product v × S q̇ = v × v is zero.
+  ws.vdot.head<6>() = a - data.liMi[0].actInv(ws.a_world);
+  ws.lambda.setZero();
+  for (int i = 0; i < m; ++i) ws.lambda[global[i]] = e[i] * r[i];
+  ws.redundant = 0;
+  ws.loop_rank = 0;
+  return true;
+}
+
+}  // namespace appell::detail
