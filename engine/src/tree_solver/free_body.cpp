@@ -5,11 +5,11 @@
 //   a₀ = I⁻¹ f₀,   (K I⁻¹ Kᵀ) μ = k − K a₀,   a = a₀ + I⁻¹ Kᵀ μ,
 // with I = L Lᵀ (Model::spatial_inertia_factor) and Y = L⁻¹ Kᵀ, so that
 // K I⁻¹ Kᵀ = Yᵀ Y and a = L⁻ᵀ(L⁻¹ f₀ + Y μ). I is constant in the body's
-// frame, so L⁻¹ is formed once (TreeSolver's constructor) and every solve is
-// fixed-size 6 × 6 products plus an m × m Cholesky (m ≤ 6 rows, stored padded
-// with zero rows): the general passes' answer without their dynamic-size
+// frame, so L⁻¹ is formed once (TreeSolver's constructor) and a solve is
+// m + 2 fixed-size 6 × 6 matrix-vector products and an m × m Cholesky
+// (m ≤ 6 rows): the general passes' answer without their dynamic-size
 // machinery (compression, split, articulated inertia) and without the
-// division chains of triangular solves.
+// division chains of 6 × 6 triangular solves.
 //
 // It is taken only where it is that answer. The rows, equilibrated (E K),
 // must be resolved whole by the free joint, which the general passes decide
@@ -18,7 +18,7 @@
 // Cholesky factor of the rows' Gram matrix, E K Kᵀ E = Lg Lgᵀ (Lg is the LQ
 // factor of E K, so σ(E K) = σ(Lg)). Then no row is redundant, μ is unique,
 // and the result agrees with the passes to round-off (tests/test_tree_solver.cpp,
-// FreeBody…). Anything else — redundant or weak rows, sliding contacts'
+// AFreeBodysClosedFormIsThePassesAnswer). Anything else — redundant or weak rows, sliding contacts'
 // friction rows (zero rows), more than 6 rows — goes to the passes.
 #include "tree_solver/workspace.hpp"
 
@@ -82,8 +82,8 @@ double sigmaMinBound(const Mat6& l, const double inv[6], int n) {
 bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& cdata,
                    TreeWorkspace& ws, bool impulse) {
   // The rows in the body frame, equilibrated, as the columns of Kt = (E K)ᵀ
-  // (zero past the m-th); k_e = E k.
-  Mat6 Kt = Mat6::Zero();
+  // (the first m of them); k_e = E k.
+  Mat6 Kt;
   double k[6], e[6];
   int global[6];
   int m = 0;
@@ -120,20 +120,20 @@ bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& c
     const Vec6& v = data.v[0];
     z.noalias() = Linv * (ws.tau.head<6>() - crossForce(v, model.spatial_inertia[0] * v));
   }
-  Mat6 Y, S;
-  Y.noalias() = Linv * Kt;
-  for (int i = 0; i < m; ++i)
+  Mat6 Y, S;  // the first m columns, and the leading m × m
+  double r[6];
+  for (int i = 0; i < m; ++i) {
+    Y.col(i).noalias() = Linv * Kt.col(i);
+    r[i] = k[i] - Y.col(i).dot(z);
     for (int j = 0; j <= i; ++j) S(i, j) = Y.col(i).dot(Y.col(j));
-  Vec6 r = Vec6::Zero();
-  r.head(m) = Eigen::Map<const Vec6>(k).head(m);
-  r.noalias() -= Y.transpose() * z;  // entries past m: 0 − 0
+  }
   if (m > 0) {
     if (!cholesky(S, m, inv)) return false;
-    choleskySolve(S, inv, m, r.data());  // r = μ_e
+    choleskySolve(S, inv, m, r);  // r = μ_e
   }
 
   // a = L⁻ᵀ(z + Y μ_e); λ = E μ_e (the force on the body is K_eᵀ μ_e = Kᵀ E μ_e).
-  z.noalias() += Y * r;
+  for (int i = 0; i < m; ++i) z += r[i] * Y.col(i);
   const Vec6 a = Linv.transpose() * z;
   // Gravity-shifted (ABA's trick): q̈ = a − ᵖXᵢ a_world; a free joint's
   // velocity product v × S q̇ = v × v is zero.
