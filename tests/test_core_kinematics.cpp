@@ -280,3 +280,37 @@ INSTANTIATE_TEST_SUITE_P(Integrators, QuaternionNorm,
                          [](const ::testing::TestParamInfo<IntegratorType>& p) {
                            return std::string(toString(p.param));
                          });
+
+// forwardKinematicsIfStale (the tree solver's kinematics after the rows'):
+// it recomputes whenever q or v differ from the state Data was last computed
+// for, or when only positions were — and skips otherwise, which the poisoned
+// pose below makes visible.
+TEST(CoreKinematics, KinematicsAreRecomputedExactlyWhenTheStateChanged) {
+  std::mt19937 rng(5);
+  const Model model = test::randomTree(6, true, rng);
+  Data data(model), fresh(model);
+  VecX q = randomConfiguration(model, rng);
+  VecX v = test::randomVector(model.nv, rng);
+  auto sameAsFresh = [&](const VecX& qq, const VecX& vv) {
+    forwardKinematics(model, fresh, qq, vv);
+    for (int i = 0; i < model.nbodies; ++i)
+      if (!data.oMi[i].toMotionMatrix().isApprox(fresh.oMi[i].toMotionMatrix(), 1e-15) ||
+          !data.v[i].isApprox(fresh.v[i], 1e-15))
+        return false;
+    return true;
+  };
+  forwardKinematics(model, data, q, v);
+  q[2] += 1e-3;  // a changed q (in place, as integrators do)
+  forwardKinematicsIfStale(model, data, q, v);
+  EXPECT_TRUE(sameAsFresh(q, v));
+  v[model.nv - 1] += 1e-3;  // a changed v
+  forwardKinematicsIfStale(model, data, q, v);
+  EXPECT_TRUE(sameAsFresh(q, v));
+  forwardKinematics(model, data, q);  // positions only: the velocities are not current
+  data.v[0].setConstant(7);
+  forwardKinematicsIfStale(model, data, q, v);
+  EXPECT_TRUE(sameAsFresh(q, v));
+  data.oMi[model.nbodies - 1].p.setConstant(7);  // the same (q, v): not recomputed
+  forwardKinematicsIfStale(model, data, q, v);
+  EXPECT_EQ(data.oMi[model.nbodies - 1].p, Vec3::Constant(7));
+}

@@ -23,6 +23,13 @@ struct Data {
   std::vector<SE3> oMi;    ///< body i in the world
   std::vector<Vec6> v;     ///< body spatial velocity, body frame
   std::vector<Vec6> a;     ///< body spatial acceleration, body frame (gravity NOT included)
+  /// The (q, v) the kinematics above were last computed for: forwardKinematics
+  /// writes them (kinematics_has_v false after the position-only one), so an
+  /// algorithm handed the same (q, v) skips recomputing them
+  /// (forwardKinematicsIfStale). Writing liMi, oMi or v by hand: clear
+  /// kinematics_has_v.
+  VecX kinematics_q, kinematics_v;
+  bool kinematics_has_v = false;
 
   // Dynamics.
   std::vector<Vec6> f;     ///< RNEA: force transmitted by joint i, body frame

@@ -13,6 +13,11 @@ void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX
 void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX& v,
                        const VecX& a);
 
+/// forwardKinematics(q, v) unless data already holds it for exactly this
+/// (q, v) (Data::kinematics_q/v): the tree solver after the constraint rows
+/// were evaluated at the same state does the kinematics once.
+void forwardKinematicsIfStale(const Model& model, Data& data, const VecX& q, const VecX& v);
+
 /// World-frame spatial velocity V = [ω; v_O] and acceleration dV/dt of a body
 /// (v_O: velocity of the body point now at the world origin).
 Vec6 spatialVelocityWorld(const Data& data, int body);

@@ -16,10 +16,18 @@ void placeBody(const Model& model, Data& data, const VecX& q, int i) {
   data.oMi[i] = p < 0 ? data.liMi[i] : data.oMi[p] * data.liMi[i];
 }
 
+/// Records the state the kinematics are now for (no allocation: Data sized them).
+void stamp(Data& data, const VecX& q, const VecX* v) {
+  data.kinematics_q = q;
+  data.kinematics_has_v = v != nullptr;
+  if (v) data.kinematics_v = *v;
+}
+
 }  // namespace
 
 void forwardKinematics(const Model& model, Data& data, const VecX& q) {
   for (int i = 0; i < model.nbodies; ++i) placeBody(model, data, q, i);
+  stamp(data, q, nullptr);
 }
 
 void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX& v) {
@@ -31,6 +39,14 @@ void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX
     if (p >= 0) vi += data.liMi[i].actInv(data.v[p]);
     data.v[i] = vi;
   }
+  stamp(data, q, &v);
+}
+
+void forwardKinematicsIfStale(const Model& model, Data& data, const VecX& q, const VecX& v) {
+  if (data.kinematics_has_v && data.kinematics_q.size() == q.size() &&
+      data.kinematics_v.size() == v.size() && data.kinematics_q == q && data.kinematics_v == v)
+    return;
+  forwardKinematics(model, data, q, v);
 }
 
 void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX& v,
@@ -49,6 +65,7 @@ void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX
     data.v[i] = vi;
     data.a[i] = ai + crossMotion(vi, vJ);
   }
+  stamp(data, q, &v);
 }
 
 Vec6 spatialVelocityWorld(const Data& data, int body) { return data.oMi[body].act(data.v[body]); }

@@ -4,7 +4,8 @@ namespace appell {
 
 Data::Data(const Model& model, MassMatrix mass)
     : liMi(model.nbodies), oMi(model.nbodies), v(model.nbodies, Vec6::Zero()),
-      a(model.nbodies, Vec6::Zero()), f(model.nbodies, Vec6::Zero()), tau(VecX::Zero(model.nv)),
+      a(model.nbodies, Vec6::Zero()), kinematics_q(VecX::Zero(model.nq)),
+      kinematics_v(VecX::Zero(model.nv)), f(model.nbodies, Vec6::Zero()), tau(VecX::Zero(model.nv)),
       nle(VecX::Zero(model.nv)), M(mass == MassMatrix::Sized ? MatX::Zero(model.nv, model.nv) : MatX()), ddq(VecX::Zero(model.nv)),
       Ic(model.nbodies, Mat6::Zero()), IA(model.nbodies, Mat6::Zero()),
       pA(model.nbodies, Vec6::Zero()), c(model.nbodies, Vec6::Zero()),

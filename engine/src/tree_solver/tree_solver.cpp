@@ -219,7 +219,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     return;
   }
 
-  forwardKinematics(model, data, q, v);
+  forwardKinematicsIfStale(model, data, q, v);  // done once with the rows
   // Right sides on the gravity-shifted accelerations a' = a − g (ABA's trick):
   // w·a + κ = 0  ⇔  w·a' = −κ − w_lin·g.
   for (auto& tb : ws.blocks) {
@@ -270,7 +270,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
 
   // min ½‖Δ‖²_M  s.t.  A Δ = −(A v + b): the dynamics problem with no forces,
   // no velocity products, no gravity, and the velocity residual as right side.
-  forwardKinematics(model, data, q, v);
+  forwardKinematicsIfStale(model, data, q, v);
   for (auto& tb : ws.blocks) {
     const RowBlock& blk = cdata.blocks[tb.constraint];
     const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
