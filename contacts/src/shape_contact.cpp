@@ -99,6 +99,13 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
     if (!(spec_.mu > 0 && std::isfinite(spec_.mu)))
       fail("spin friction needs a finite friction coefficient μ > 0 (the cone it shares)");
   }
+  if (!(spec_.creep_speed >= 0 && std::isfinite(spec_.creep_speed)))
+    fail("the creep speed must be ≥ 0 and finite (m/s; 0: Coulomb with sticking), got " +
+         std::to_string(spec_.creep_speed));
+  if (spec_.creep_speed > 0 && !(spec_.mu > 0 && std::isfinite(spec_.mu)))
+    fail("a creep speed needs a finite friction coefficient μ > 0 (the force it saturates at)");
+  if (spec_.creep_speed > 0 && !spec_.unilateral)
+    fail("a creep speed needs a unilateral contact (friction acts on unilateral contacts)");
   try {
     validateShape(shape);
     validateSupport(support);

@@ -74,6 +74,11 @@ struct ContactSpec {
   /// (docs/contacts.md §8). NaN: none (the spin row is ideal while the
   /// contact sticks and free while it slides). Needs a finite μ > 0.
   double mu_spin = std::numeric_limits<double>::quiet_NaN();
+  /// Regularized friction (Constraint::creepSpeed): the slip speed v_c > 0
+  /// (m/s) below which the friction force grows linearly with the slip,
+  /// μₖλₙ s/v_c, instead of sticking. 0: Coulomb, with sticking. Needs a
+  /// finite μ > 0 and a unilateral contact.
+  double creep_speed = 0;
   /// The contact can open: it lifts off when its normal force would pull and
   /// closes when its gap reaches zero (contact_events.hpp). false: a
   /// bilateral idealisation (a wheel on a rail that holds it down).
@@ -114,6 +119,7 @@ class ShapeContact : public Constraint {
     return std::isnan(spec_.mu_kinetic) ? spec_.mu : spec_.mu_kinetic;
   }
   double spinFriction() const override { return spec_.mu_spin; }
+  double creepSpeed() const override { return spec_.creep_speed; }
   /// makeContactPoints: the pair's description (shared by its points) and
   /// this point's index; null and 0 for a single contact.
   const void* pointGroup() const override { return group_.get(); }

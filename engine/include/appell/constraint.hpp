@@ -131,6 +131,15 @@ class Constraint {
   /// force is μₖ λₙ; friction() is then the static one, the cone sticking
   /// stays in and a stopped slip must fit to stick again. Default: the same.
   virtual double kineticFriction() const { return friction(); }
+  /// Regularized Coulomb friction: a creep speed v_c > 0 (m/s). The contact
+  /// then never sticks: while closed it always carries the friction force
+  ///     f = −μₖ λₙ s / max(|s|, v_c)
+  /// of its slip velocity s — viscous creep μₖλₙ/v_c below v_c, Coulomb's
+  /// μₖλₙ above (Drake's "stiction tolerance"; a tyre's linear range before
+  /// saturation) — so rows that ideal rolling would make nearly dependent
+  /// (four tyres on uneven ground) are never constraints. 0: Coulomb with
+  /// sticking (docs/contacts.md §8). Only read when friction() is finite.
+  virtual double creepSpeed() const { return 0; }
   /// Torsional (spin) friction, a length ℓ: a sticking contact's spin row
   /// holds while its friction (λₜ, τₙ/(ℓ/μ)) stays in the cone μ λₙ — the
   /// torque alone up to ℓ λₙ — and a sliding one takes the maximally

@@ -78,6 +78,10 @@ struct ConstraintData {
   };
   std::vector<SlidingRows> slide;            ///< per constraint (n = 0: no friction rows)
   bool isSliding(int constraint) const { return sliding[constraint] != 0; }
+  /// Per constraint: its friction is regularized (Constraint::creepSpeed > 0,
+  /// a finite μ and friction rows): it has no sticking mode, so setActive
+  /// closes it sliding.
+  std::vector<char> regularized;
   /// Makes a closed constraint slide or stick (keeps m_active); no allocation.
   void setSliding(int constraint, bool slides);
   bool singular = false;           ///< some constraint reported singular geometry

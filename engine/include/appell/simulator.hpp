@@ -181,8 +181,9 @@ class Simulator {
   bool frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,
                          const std::vector<int>& rows, int detail::UnilateralRow::*first, int F,
                          detail::FrictionProblem& p, bool with_velocities = false);
-  /// An impact's friction impulses (friction_impact.cpp).
-  bool frictionImpact(std::string& error);
+  /// An impact's friction impulses (friction_impact.cpp). When they would
+  /// pull a contact that was at rest in the set, `separating` names it.
+  bool frictionImpact(std::string& error, int& separating);
   void shiftImpactTargets();
   Vec3 contactSlip(int k) const;
   /// At a state where the sticking rows turned out inconsistent: the

@@ -22,6 +22,7 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
   }
   active.assign(constraints.size(), 1);
   sliding.assign(constraints.size(), 0);
+  regularized.assign(constraints.size(), 0);
   slide.resize(constraints.size());
   for (size_t k = 0; k < constraints.size(); ++k) {
     const Constraint& c = *constraints[k];
@@ -38,6 +39,7 @@ ConstraintData::ConstraintData(const Model& model, const ConstraintList& constra
           slide[k].row[slide[k].n++] = r;
           break;
         }
+    regularized[k] = slide[k].n > 0 && std::isfinite(mu) && c.creepSpeed() > 0;
   }
   m_active = m;
   b = VecX::Zero(m);
@@ -61,7 +63,10 @@ void ConstraintData::setActive(int constraint, bool closed) {
   active[constraint] = closed ? 1 : 0;
   const int rows = isSliding(constraint) ? 1 : rowsOf(*this, constraint);
   m_active += closed ? rows : -rows;
-  sliding[constraint] = 0;  // an open contact neither sticks nor slides; it closes sticking
+  // An open contact neither sticks nor slides; it closes sticking, or
+  // sliding when its friction is regularized (it has no sticking mode).
+  sliding[constraint] = 0;
+  if (closed && regularized[constraint]) setSliding(constraint, true);
 }
 
 void ConstraintData::setSliding(int constraint, bool slides) {

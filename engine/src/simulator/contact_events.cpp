@@ -67,16 +67,23 @@ void Simulator::setUpUnilateral() {
       throw std::invalid_argument("Simulator: constraint '" + con.name() +
                                   "' has kinetic friction μₖ = " + std::to_string(mu_k) +
                                   " outside [0, μ = " + std::to_string(mu) + "]");
+    const double creep = con.creepSpeed();
+    if (!(creep >= 0 && std::isfinite(creep)))
+      throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has creep speed " +
+                                  std::to_string(creep) + " (must be ≥ 0 and finite)");
     if (std::isfinite(mu) && cdata_->slide[c].n > 0) {
       r.mu = mu;
       r.mu_k = mu_k;
       r.nf = cdata_->slide[c].n;
+      r.creep = creep;
     }
     r.slot = con.pointSlot();
     uni_->rows.push_back(r);
   }
   if (!uni_) return;
   auto& u = *uni_;
+  for (const auto& r : u.rows)  // regularized friction: closed means sliding
+    if (cdata_->regularized[r.c] && cdata_->isActive(r.c)) cdata_->setSliding(r.c, true);
   for (int i = 0; i < static_cast<int>(u.rows.size()); ++i) {
     const void* group = constraints_[u.rows[i].c]->pointGroup();
     if (!group) continue;
@@ -169,7 +176,7 @@ int Simulator::crossedConstraint(detail::Crossing& type) const {
       else if (r.nf > 0 && !cdata_->isSliding(r.c) &&
                frictionForce(k, result_.lambda).norm() > r.mu * fn + ftol)
         type = Crossing::Cone;
-      else if (r.nf > 0 && cdata_->isSliding(r.c) &&
+      else if (r.nf > 0 && r.creep == 0 && cdata_->isSliding(r.c) &&
                cdata_->slide[r.c].slip.dot(r.dir_start) <
                    -options_.contacts.speed_tol)
         type = Crossing::Slip;
@@ -318,9 +325,12 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h, int k,
       if (!cdata_->isActive(r.c)) {
         if (!r.dormant && cdata_->gap[r.global] < -o.gap_tol)
           earlier = j, earlier_type = detail::Crossing::Gap;
-      } else if (cdata_->isSliding(r.c)) {
+      } else if (cdata_->isSliding(r.c) && r.creep == 0) {
         if (eventFunction(j, detail::Crossing::Slip) < -o.speed_tol)
           earlier = j, earlier_type = detail::Crossing::Slip;
+      } else if (cdata_->isSliding(r.c)) {  // regularized: only its load can cross
+        if (options_.evaluate_end_state && eventFunction(j, detail::Crossing::Normal) < -o.force_tol)
+          earlier = j, earlier_type = detail::Crossing::Normal;
       } else if (options_.evaluate_end_state) {
         if (eventFunction(j, detail::Crossing::Normal) < -o.force_tol)
           earlier = j, earlier_type = detail::Crossing::Normal;
@@ -517,7 +527,9 @@ void Simulator::shiftImpactTargets() {
 
 /// Impact: Newton's law on the touching contacts that approach, with the
 /// velocity projection as the impulse solve, by principal pivoting; then
-/// Coulomb's law on their friction impulses (friction_impact.cpp).
+/// Coulomb's law on their friction impulses (friction_impact.cpp). A set
+/// member at rest that those impulses would pull separates: it leaves the
+/// set for good and the impact is solved again (at most once per contact).
 bool Simulator::impactPhase(std::string& error) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
@@ -527,6 +539,7 @@ bool Simulator::impactPhase(std::string& error) {
     auto& r = u.rows[k];
     r.impulse = r.tangential = 0;
     r.target = 0;
+    r.separated = false;
     if (!r.touching) continue;
     r.gamma = rowVelocity(k);
     if (r.gamma < -o.speed_tol) {
@@ -537,68 +550,78 @@ bool Simulator::impactPhase(std::string& error) {
     r.in_set = r.was_closed || r.gamma < -o.speed_tol;
   }
   if (!any) return true;
-  int last_flip = -1, next_unload = 0;
-  for (int it = 0;; ++it) {
-    if (it == o.max_mode_iterations) {
-      error = "impact: no consistent set of contacts after " + std::to_string(it) + " pivots";
-      return false;
-    }
-    for (auto& r : u.rows)
-      if (r.touching) cdata_->setActive(r.c, r.in_set);
-    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    shiftImpactTargets();
-    u.vplus = v_;
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
-      // Restitution targets on redundant rows can contradict each other: a
-      // ball resting on one slope of a valley that strikes the other with
-      // e > 0 cannot both rebound there and keep rolling on the first (two
-      // points of one rigid body keep their distance). A set member at rest
-      // (no target) is then the one that gives way: it leaves the set, and
-      // the pivoting goes on (it rejoins if it would approach).
-      int resting = -1;
-      for (int k = 0; k < static_cast<int>(u.rows.size()) && resting < 0; ++k) {
-        const auto& r = u.rows[k];
-        if (r.touching && r.in_set && r.target == 0 && r.gamma >= -o.speed_tol) resting = k;
-      }
-      if (resting < 0) {
-        error = "impact: the impulse solve failed: " + solver_->lastError();
+  for (int round = 0;; ++round) {
+    int last_flip = -1, next_unload = 0;
+    for (int it = 0;; ++it) {
+      if (it == o.max_mode_iterations) {
+        error = "impact: no consistent set of contacts after " + std::to_string(it) + " pivots";
         return false;
       }
-      u.rows[resting].in_set = false;
-      last_flip = resting;
-      continue;
+      for (auto& r : u.rows)
+        if (r.touching) cdata_->setActive(r.c, r.in_set);
+      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+      shiftImpactTargets();
+      u.vplus = v_;
+      if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
+        // Restitution targets on redundant rows can contradict each other: a
+        // ball resting on one slope of a valley that strikes the other with
+        // e > 0 cannot both rebound there and keep rolling on the first (two
+        // points of one rigid body keep their distance). A set member at rest
+        // (no target) is then the one that gives way: it leaves the set, and
+        // the pivoting goes on (it rejoins if it would approach).
+        int resting = -1;
+        for (int k = 0; k < static_cast<int>(u.rows.size()) && resting < 0; ++k) {
+          const auto& r = u.rows[k];
+          if (r.touching && r.in_set && r.target == 0 && r.gamma >= -o.speed_tol) resting = k;
+        }
+        if (resting < 0) {
+          error = "impact: the impulse solve failed: " + solver_->lastError();
+          return false;
+        }
+        u.rows[resting].in_set = false;
+        last_flip = resting;
+        continue;
+      }
+      std::swap(v_, u.vplus);  // rowVelocity reads v_ and data_ at v⁺
+      forwardKinematics(model_, *data_, q_, v_);
+      double scale = 0;
+      for (const auto& r : u.rows)
+        if (r.touching && r.in_set) scale = std::max(scale, std::abs(u.impulse[r.global]));
+      int flip = -1;
+      for (int k = 0; k < static_cast<int>(u.rows.size()) && flip < 0; ++k) {
+        auto& r = u.rows[k];
+        if (!r.touching) continue;
+        if (r.in_set) {
+          r.impulse = -u.impulse[r.global];  // v⁺ = v − M⁻¹Aᵀμ: the push along the row is −μ
+          if (r.impulse < -1e-10 * (1 + scale)) flip = k;
+        } else if (!r.separated && rowVelocity(k) + r.target < -o.speed_tol) {
+          flip = k;
+        }
+      }
+      if (flip < 0) break;
+      std::swap(v_, u.vplus);  // back to the pre-impact velocity
+      if (flip == last_flip) {  // it would pull, and out of the set it approaches
+        if (!breakTwoCycle(u.rows, flip, last_flip, next_unload)) {
+          error = "impact: no consistent set of contacts: '" + constraints_[u.rows[flip].c]->name() +
+                  "' would pull and cannot stay out";
+          return false;
+        }
+        continue;
+      }
+      u.rows[flip].in_set = !u.rows[flip].in_set;
+      last_flip = flip;
     }
-    std::swap(v_, u.vplus);  // rowVelocity reads v_ and data_ at v⁺
+    // (u.vplus holds v⁻.)
+    int separating = -1;
+    if (frictionImpact(error, separating)) break;
+    // The friction impulses would pull a set member that was at rest: it
+    // separates — out of the set, and the impact is solved again from v⁻.
+    if (separating < 0 || round == static_cast<int>(u.rows.size())) return false;
+    u.rows[separating].in_set = false;
+    u.rows[separating].separated = true;
+    v_ = u.vminus;
     forwardKinematics(model_, *data_, q_, v_);
-    double scale = 0;
-    for (const auto& r : u.rows)
-      if (r.touching && r.in_set) scale = std::max(scale, std::abs(u.impulse[r.global]));
-    int flip = -1;
-    for (int k = 0; k < static_cast<int>(u.rows.size()) && flip < 0; ++k) {
-      auto& r = u.rows[k];
-      if (!r.touching) continue;
-      if (r.in_set) {
-        r.impulse = -u.impulse[r.global];  // v⁺ = v − M⁻¹Aᵀμ: the push along the row is −μ
-        if (r.impulse < -1e-10 * (1 + scale)) flip = k;
-      } else if (rowVelocity(k) + r.target < -o.speed_tol) {
-        flip = k;
-      }
-    }
-    if (flip < 0) break;
-    std::swap(v_, u.vplus);  // back to the pre-impact velocity
-    if (flip == last_flip) {  // it would pull, and out of the set it approaches
-      if (!breakTwoCycle(u.rows, flip, last_flip, next_unload)) {
-        error = "impact: no consistent set of contacts: '" + constraints_[u.rows[flip].c]->name() +
-                "' would pull and cannot stay out";
-        return false;
-      }
-      continue;
-    }
-    u.rows[flip].in_set = !u.rows[flip].in_set;
-    last_flip = flip;
   }
-  // (u.vplus holds v⁻.)
-  if (!frictionImpact(error)) return false;
   // v_ is v⁺. Contacts that took an impulse with restitution rebound: open.
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
     auto& r = u.rows[k];
@@ -746,6 +769,11 @@ bool Simulator::frictionPhase(std::string& error, int forced) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
   bool onset_done = false;
+  // Regularized contacts slide whenever closed (their force a function of
+  // the slip); nothing below decides their mode.
+  for (UnilateralRow& r : u.rows)
+    if (r.creep > 0 && cdata_->isActive(r.c) && !cdata_->isSliding(r.c))
+      cdata_->setSliding(r.c, true);
   for (int it = 0;; ++it) {
     if (it == o.max_mode_iterations) {
       error = "friction modes: no consistent stick/slip set after " + std::to_string(it) + " passes";
@@ -763,7 +791,9 @@ bool Simulator::frictionPhase(std::string& error, int forced) {
       bool needed = forced >= 0;
       for (int k = 0; k < static_cast<int>(u.rows.size()) && !needed; ++k) {
         const UnilateralRow& r = u.rows[k];
-        if (r.nf == 0 || !cdata_->isActive(r.c) || contactSlip(k).norm() > o.speed_tol) continue;
+        if (r.nf == 0 || r.creep > 0 || !cdata_->isActive(r.c) ||
+            contactSlip(k).norm() > o.speed_tol)
+          continue;
         needed = cdata_->isSliding(r.c) ||
                  frictionForce(k, u.res.lambda).norm() > r.mu * u.res.lambda[r.global] + o.force_tol;
       }

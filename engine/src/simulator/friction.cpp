@@ -21,6 +21,7 @@
 
 #include "simulator/simulator_internal.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace appell {
@@ -38,6 +39,13 @@ void detail::slipDirection(const ConstraintData& cd, UnilateralRow& r, double fl
   // Components beyond the contact's friction rows are zero throughout (the
   // rows' storage starts zero), so whole 3-vectors are used.
   const double speed = sr.slip.norm();
+  // Regularized: a continuous function of the slip, linear below the creep
+  // speed — the force −μₖλₙ dir is then smooth in the state and the slip may
+  // pass through zero without an event.
+  if (r.creep > 0) {
+    r.dir = sr.slip / std::max(speed, r.creep);
+    return;
+  }
   if (speed > floor && sr.slip.dot(r.dir_start) > 0) r.dir = sr.slip / speed;
   else r.dir = r.dir_start;
 }
@@ -59,7 +67,8 @@ bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX
       r.settling = false;
       if (!cdata_->isActive(r.c) || !cdata_->isSliding(r.c)) continue;
       u->sliding.push_back(k);
-      if (r.nf > 0 && cdata_->slide[r.c].slip.norm() <= screen) r.settling = settling = true;
+      if (r.nf > 0 && r.creep == 0 && cdata_->slide[r.c].slip.norm() <= screen)
+        r.settling = settling = true;
     }
     if (settling) return solveSettling(t, q, v, tau, out, outputs);
   }

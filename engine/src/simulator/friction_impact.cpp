@@ -26,9 +26,21 @@
 // disk sticks (s⁺ = 0), one on it slides through the impact with the kinetic
 // impulse μₖPₙ and leaves sliding along s⁺. A sliding contact's spin row
 // (rolling without spin) takes no impulse: spin friction is not modelled.
-// A normal impulse that the friction impulses would turn negative has no
-// consistent sliding impact (Painlevé's paradox at the impulse level:
-// Stewart, SIAM Review 42 (2000)): reported with the contact named.
+// A normal impulse that the friction impulses would turn negative belongs,
+// when its contact was at rest in the set (it did not approach; its normal
+// impulse without friction was ~0 — a tyre that merely carried load while
+// another landed), to a contact that separates: it is handed back
+// (`separating`) and the impact phase solves the impact again without it
+// (the pivot the normal impulses' complementarity asks for). A contact
+// that approached has no consistent sliding impact (Painlevé's paradox at
+// the impulse level: Stewart, SIAM Review 42 (2000)): reported with the
+// contact named.
+//
+// A regularized contact (creep speed v_c, friction.cpp) takes part as a
+// Coulomb contact: its law's force is μₖλₙ s/v_c with λₙ impulsive, so the
+// slip relaxes within the impact on the impulse scale v_c/(μₖ W) — fast
+// against a landing's normal impulse — which is Coulomb's sticking impact
+// in the limit. It leaves sliding, as it always is when closed.
 #include <appell/kinematics.hpp>
 #include <appell/simulator.hpp>
 
@@ -40,7 +52,8 @@ namespace appell {
 
 using detail::UnilateralRow;
 
-bool Simulator::frictionImpact(std::string& error) {
+bool Simulator::frictionImpact(std::string& error, int& separating) {
+  separating = -1;
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
   // Here v_ = v⁺ with every contact sticking, u.vplus = v⁻, u.impulse the
@@ -140,6 +153,7 @@ bool Simulator::frictionImpact(std::string& error) {
     if (pn < -o.force_tol) {
       restore(false);
       v_ = u.vstick;
+      if (r.gamma >= -o.speed_tol) separating = k;  // at rest: it may separate instead
       error = "impact with friction: the friction impulses would pull contact '" +
               constraints_[r.c]->name() +
               "' off the support (a Painlevé-type impact: no consistent sliding impact)";
@@ -156,8 +170,11 @@ bool Simulator::frictionImpact(std::string& error) {
       r.dir = slip / slip.norm();
       r.dir_start = r.dir;
     }
-    cdata_->setSliding(r.c, slides);
-    const bool was = u.was_sliding[k] != 0;
+    // A regularized contact leaves sliding whatever its slip (its force is
+    // then μₖλₙ s/v_c: no stick or slip event).
+    cdata_->setSliding(r.c, slides || r.creep > 0);
+    const bool was = u.was_sliding[k] != 0 && r.creep == 0;
+    if (r.creep > 0) continue;
     if (slides && !was) logEvent(ContactEventKind::Slip, k, 0, slip.norm(), 0);
     if (!slides && was) logEvent(ContactEventKind::Stick, k, 0, 0, 0);
   }

@@ -186,7 +186,7 @@ bool Simulator::frictionOnset(int forced, std::string& error) {
   int F = 0;
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
     UnilateralRow& r = u.rows[k];
-    if (r.nf == 0 || !cdata_->isActive(r.c)) continue;
+    if (r.nf == 0 || r.creep > 0 || !cdata_->isActive(r.c)) continue;
     if (k != forced && contactSlip(k).norm() > o.speed_tol) continue;
     r.first_force = F;
     F += r.nf;

@@ -41,12 +41,17 @@ struct UnilateralRow {
   double impulse = 0, tangential = 0;
   bool touching = false, in_set = false, was_closed = false, lifting = false, touching_down = false;
   bool bounced = false;   // rebounded at this event: open, not a force candidate
+  bool separated = false; // left the impact's set: its friction impulses would pull it
   double gap_start = 0;   // gap at the start of the step (open contacts)
   // Coulomb friction (friction.cpp): μ, and while sliding the slip direction
   // in the friction rows' coordinates (unit; kept when the slip is ~0).
   double mu = std::numeric_limits<double>::infinity();  // static: the sticking cone
   double mu_k = std::numeric_limits<double>::infinity();  // kinetic: the sliding force
   int nf = 0;             // friction rows (0: frictionless or bilateral)
+  // Regularized friction (Constraint::creepSpeed): > 0, the contact slides
+  // whenever closed, dir = s / max(|s|, creep) (|dir| ≤ 1); no stick or
+  // slip events, no onset or settling decisions.
+  double creep = 0;
   Vec3 dir = Vec3::Zero();
   Vec3 dir_start = Vec3::Zero();  // at the step's start: the slip-reversal event's reference
   // Friction released for frictionOnset: sliding without a friction force

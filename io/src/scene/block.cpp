@@ -135,7 +135,8 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
   if (has_shape && has_point) fail(src, e, "give either 'shape' or 'point', not both");
   static const char* const kCommon[] = {"name",      "link",        "kind",      "support",
                                         "mu",        "direction",   "restitution", "unilateral",
-                                        "mu_static", "mu_kinetic", "mu_spin",  "points"};
+                                        "mu_static", "mu_kinetic", "mu_spin",  "points",
+                                        "creep_speed"};
   auto allow = [&](const std::vector<const char*>& extra) {
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string n = a->Name();
@@ -227,6 +228,17 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
       fail(src, e, "'mu_spin' needs kind=\"rolling_without_spin\" (a contact with a spin row)");
     if (!(d.spec.mu > 0 && std::isfinite(d.spec.mu)))
       fail(src, e, "'mu_spin' needs a finite 'mu' > 0 (the friction cone it shares)");
+  }
+  if (has(e, "creep_speed")) {
+    d.spec.creep_speed = number(src, e, "creep_speed");
+    if (!(d.spec.creep_speed > 0 && std::isfinite(d.spec.creep_speed)))
+      fail(src, e, "'creep_speed' must be a positive slip speed (m/s): below it the friction "
+                   "force grows linearly with the slip");
+    if (!(d.spec.mu > 0 && std::isfinite(d.spec.mu)))
+      fail(src, e, "'creep_speed' needs a finite 'mu' > 0 (the force it saturates at)");
+    if (has(e, "mu_static"))
+      fail(src, e, "'creep_speed' takes one coefficient 'mu', not 'mu_static' with "
+                   "'mu_kinetic': a regularized contact never sticks");
   }
   if (has(e, "restitution")) {
     d.spec.restitution = number(src, e, "restitution");
