@@ -555,3 +555,55 @@ TEST(FrictionVehicles, AParallelSteeredCarStartsToScrubWhenItsHandWheelTurnsAtSp
     EXPECT_LT((other->v() - sim->v()).norm(), 1e-8) << toString(f);
   }
 }
+
+// Protects: a car on uneven ground with creeping tyres (examples/
+// suspended_car: four struts on spring-dampers, tyres μ = 0.9 with a creep
+// speed v_c = 0.1 m/s, over sines within ±5 cm). With ideal or sticking
+// tyres this car stops around its landing (t = 0.15 s, 0.11 s): its rear
+// tyres' lateral rows are nearly dependent on two different cross-slopes,
+// and their exact multipliers reach ±10¹⁰ N (docs/contacts.md §4). With the
+// creep law they are forces, and the car coasts on at 4 m/s. Checked at
+// every step end:
+// every step succeeds; every closed tyre slides and carries exactly its
+// law, λₜ = −μ λₙ s/max(|s|, v_c), so |λₜ| ≤ μ λₙ; the tyres lift off over
+// the crests and land again (located events); the work balance
+// E + impact losses + friction work − servo work = E₀ closes to 1e-9
+// (relative; measured 1.6e-11) and the residuals stay at round-off.
+TEST(FrictionVehicles, ASuspendedCarWithCreepingTyresCrossesUnevenGround) {
+  const Scene scene = loadScene(example("suspended_car/suspended_car.urdf"));
+  RunOptions o = runOptions(scene.settings);
+  auto sim = makeSimulator(scene, o);
+  const double E0 = sim->energy(), mu = 0.9, vc = 0.1;
+  const ConstraintData& cd = sim->constraintData();
+  int lift_offs = 0, touchdowns = 0, checked = 0;
+  double worst_law = 0, residual = 0;
+  while (sim->time() < 2.5 - 1e-12) {
+    const StepStatus st = sim->step(std::min(1e-2, 2.5 - sim->time()));
+    ASSERT_TRUE(st.ok) << "at t = " << sim->time() << ": " << st.message;
+    for (const ContactEvent& e : sim->events()) {
+      lift_offs += e.kind == ContactEventKind::LiftOff;
+      touchdowns += e.kind == ContactEventKind::Touchdown;
+      EXPECT_NE(e.kind, ContactEventKind::Stick) << "a creeping tyre never sticks";
+      EXPECT_NE(e.kind, ContactEventKind::Slip);
+    }
+    residual = std::max({residual, sim->velocityResidual(), sim->gapResidual()});
+    for (int c = 0; c < 4; ++c) {
+      if (!sim->isClosed(c)) continue;
+      EXPECT_TRUE(cd.isSliding(c)) << "closed means sliding, tyre " << c;
+      const auto& sr = cd.slide[c];
+      const double load = sim->lambda()[cd.offset[c] + sim->constraints()[c]->unilateralRow()];
+      const Vec3 law = -mu * load * sr.slip / std::max(sr.slip.norm(), vc);
+      for (int i = 0; i < sr.n; ++i)
+        worst_law = std::max(worst_law, std::abs(sim->lambda()[cd.offset[c] + sr.row[i]] - law[i]));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_LT(worst_law, 1e-9) << "the friction force is the creep law (loads ~100 N)";
+  EXPECT_GE(lift_offs, 2) << "tyres lift off over the crests";
+  EXPECT_GE(touchdowns, lift_offs + 4) << "the landing, and every lift-off lands again";
+  EXPECT_LT(balanceError(*sim, E0), 1e-9 * E0);
+  EXPECT_LT(residual, 1e-10);
+  EXPECT_GT(sim->q()[0], 8.0) << "it coasted on";
+  EXPECT_LT(std::abs(sim->q()[1]), 0.05) << "and stayed on course";
+}

@@ -249,6 +249,9 @@ TEST(IoScene, StaticAndKineticFrictionCoefficients) {
   auto spinning = [&](const std::string& attrs) {
     return std::regex_replace(scene(attrs), std::regex(R"(kind="rolling")"), R"(kind="rolling_without_spin")");
   };
+  const Scene creep = loadSceneFromString(scene(R"(mu="0.5" creep_speed="0.05")"), kData, "creep");
+  EXPECT_DOUBLE_EQ(creep.contacts[0]->creepSpeed(), 0.05);
+  EXPECT_EQ(one.contacts[0]->creepSpeed(), 0) << "Coulomb with sticking unless declared";
   const Scene spin = loadSceneFromString(spinning(R"(mu="0.5" mu_spin="0.01")"), kData, "spin");
   EXPECT_DOUBLE_EQ(spin.contacts[0]->spinFriction(), 0.01);
   for (const std::string& attrs : {std::string(R"(mu_spin="0.01")"), std::string(R"(mu="0" mu_spin="0.01")")}) {
@@ -265,7 +268,13 @@ TEST(IoScene, StaticAndKineticFrictionCoefficients) {
            {R"(mu_static="0.3" mu_kinetic="0.4")", "'mu_kinetic' must not exceed 'mu_static'"},
            {R"(mu_static="0.3" mu_kinetic="-1")", "must not be negative"},
            {R"(mu="0.5" mu_spin="-0.01")", "'mu_spin' must be a positive length"},
-           {R"(mu="0.5" mu_spin="0.01")", "'mu_spin' needs kind=\"rolling_without_spin\""}}) {
+           {R"(mu="0.5" mu_spin="0.01")", "'mu_spin' needs kind=\"rolling_without_spin\""},
+           {R"(mu="0.5" creep_speed="0")", "'creep_speed' must be a positive slip speed"},
+           {R"(mu="0.5" creep_speed="-0.1")", "'creep_speed' must be a positive slip speed"},
+           {R"(creep_speed="0.1")", "'creep_speed' needs a finite 'mu' > 0"},
+           {R"(mu="0" creep_speed="0.1")", "'creep_speed' needs a finite 'mu' > 0"},
+           {R"(mu_static="0.6" mu_kinetic="0.4" creep_speed="0.1")", "'creep_speed' takes one coefficient 'mu'"},
+           {R"(mu="0.5" creep_speed="0.1" unilateral="false")", "a creep speed needs a unilateral contact"}}) {
     try {
       loadSceneFromString(scene(attrs), kData, "bad");
       ADD_FAILURE() << attrs << " accepted";
