@@ -606,4 +606,20 @@ TEST(FrictionVehicles, ASuspendedCarWithCreepingTyresCrossesUnevenGround) {
   EXPECT_LT(residual, 1e-10);
   EXPECT_GT(sim->q()[0], 8.0) << "it coasted on";
   EXPECT_LT(std::abs(sim->q()[1]), 0.05) << "and stayed on course";
+
+  // Sticking or ideal tyres: the run stops at the landing, says why, and
+  // points to the creep law.
+  const std::string text = readText(example("suspended_car/suspended_car.urdf"));
+  for (const char* rigid : {R"( creep_speed="0.1")", R"( mu="0.9" creep_speed="0.1")"}) {
+    const std::string xml = std::regex_replace(text, std::regex(rigid), "");
+    ASSERT_NE(xml, text);
+    const Scene rigid_scene = loadSceneFromString(xml, example("suspended_car"), "rigid");
+    auto stuck = makeSimulator(rigid_scene, o);
+    StepStatus st;
+    while (stuck->time() < 1.0 && (st = stuck->step(1e-2)).ok) {
+    }
+    EXPECT_FALSE(st.ok) << rigid << ": ran to t = " << stuck->time();
+    EXPECT_LT(stuck->time(), 0.5);
+    EXPECT_NE(st.message.find("'creep_speed' slip a little instead"), std::string::npos) << st.message;
+  }
 }

@@ -186,6 +186,7 @@ class Simulator {
   bool frictionImpact(std::string& error, int& separating);
   void shiftImpactTargets();
   Vec3 contactSlip(int k) const;
+  std::string rigidRollingHint() const;
   /// At a state where the sticking rows turned out inconsistent: the
   /// unilateral row whose contact slides to resolve it (its dir set), or −1
   /// (friction_overconstrained.cpp).

@@ -357,7 +357,8 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h, int k,
   if (hi <= 0) {
     if (++u.zero_events > 2)
       return fail(st, "contact '" + constraints_[u.rows[k].c]->name() +
-                          "' switches at every step start: no consistent contact mode");
+                          "' switches at every step start: no consistent contact mode" +
+                          rigidRollingHint());
   } else {
     u.zero_events = 0;
   }
@@ -401,7 +402,7 @@ StepStatus Simulator::locateAndHandleEvent(StepStatus st, double h, int k,
     if (type == detail::Crossing::Slip && !cdata_->isSliding(ev.c))
       logEvent(ContactEventKind::Stick, k, 0, 0, 0);
   } else if (!decideModes(error) || !frictionPhase(error)) {
-    return fail(st, "at t = " + std::to_string(t_) + ": " + error);
+    return fail(st, "at t = " + std::to_string(t_) + ": " + error + rigidRollingHint());
   }
   if (!projectAfterModes(error)) return fail(st, error);
   dissipated_ += T_before - appell::kineticEnergy(model_, *data_, q_, v_);
@@ -465,6 +466,21 @@ double Simulator::rowAcceleration(int k) const {
   if (r.a >= 0) g += r.wa.dot(spatialAccelerationWorld(*data_, r.a));
   if (r.b >= 0) g -= r.wb.dot(spatialAccelerationWorld(*data_, r.b));
   return g;
+}
+
+/// What a failed mode decision may mean when several closed contacts roll
+/// without slip or by Coulomb's law (sticking, or switching between stick
+/// and slip): a vehicle on uneven ground, over-constrained by its own tyres
+/// (docs/contacts.md §4). Empty when fewer than two such contacts are closed.
+std::string Simulator::rigidRollingHint() const {
+  int rigid = 0;
+  for (const auto& r : uni_->rows)
+    if (cdata_->isActive(r.c) && cdata_->slide[r.c].n > 0 && r.creep == 0) ++rigid;
+  if (rigid < 2) return "";
+  return " (" + std::to_string(rigid) +
+         " closed contacts roll without slip or stick by Coulomb's law, which can "
+         "over-constrain a vehicle on uneven ground; tyres with a finite 'mu' and a "
+         "'creep_speed' slip a little instead: docs/contacts.md §4, §8)";
 }
 
 /// Closes every touching contact, evaluates the rows at (t_, q_, v_) and keeps
