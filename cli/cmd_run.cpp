@@ -128,7 +128,10 @@ void printContacts(std::ostream& out, const RunSummary& r) {
     out << std::setprecision(4) << " normal load " << e.min_normal << " … " << e.max_normal << " N";
     if (!e.tangential_rows.empty()) {
       out << ", friction demand max " << e.max_demand << " at t=" << e.t_max_demand;
-      if (std::isfinite(e.mu)) out << " (μ = " << e.mu << ")";
+      if (std::isfinite(e.mu) && e.creep_speed > 0)
+        out << " (μ = " << e.mu << ", creeping below " << e.creep_speed << " m/s)";
+      else if (std::isfinite(e.mu))
+        out << " (μ = " << e.mu << ")";
     }
     if (e.sliding_samples)
       out << "; sliding in " << e.sliding_samples << " samples, slip speed max " << e.max_slip

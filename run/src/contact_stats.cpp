@@ -23,6 +23,7 @@ std::vector<ContactStats> contactStats(const Scene& scene) {
     // μ belongs to the contact; constraints the scene does not declare as contacts have none.
     if (k < scene.contacts.size() && scene.contacts[k] == scene.constraints[k])
       e.mu = scene.contacts[k]->mu();
+    e.creep_speed = c.creepSpeed();
     for (int r = 0; r < c.rows(); ++r) {
       const RowKind kind = c.rowKind(r);
       if (kind == RowKind::Normal) e.normal_row = offset + r;

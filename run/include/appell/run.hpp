@@ -87,6 +87,7 @@ bool anyContactCanSlip(const ConstraintList& constraints);
 struct ContactStats {
   std::string name;                ///< the constraint's name
   double mu = std::numeric_limits<double>::infinity();  ///< the scene's μ (∞: unchecked)
+  double creep_speed = 0;          ///< regularized friction's v_c (0: Coulomb with sticking)
   int normal_row = -1;             ///< λ index of the normal row, −1: none (no stats)
   std::vector<int> tangential_rows;  ///< λ indices of tangent and lateral rows
   /// With spin friction ℓ: the spin row's λ index and its unit ℓ/μ (its
