@@ -108,11 +108,12 @@ int main(int argc, char** argv) {
     const std::vector<Case> cases = {
         {IntegratorType::SymplecticEuler, "euler", {4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4}},
         {IntegratorType::RK4, "rk4", {2e-2, 1e-2, 5e-3, 2.5e-3, 1.25e-3}},
-        {IntegratorType::DormandPrince54, "dopri5", {1e-4, 1e-6, 1e-8, 1e-10, 1e-12}}};
+        {IntegratorType::DormandPrince54, "dopri5", {1e-4, 1e-6, 1e-8, 1e-10, 1e-12}},
+        {IntegratorType::DormandPrince853, "dop853", {1e-6, 1e-8, 1e-10, 1e-12}}};
     VecX dq(scene.model.nv);
     for (const Case& c : cases) {
       for (double s : c.settings) {
-        const bool adaptive = c.type == IntegratorType::DormandPrince54;
+        const bool adaptive = adaptiveIntegrator(c.type);
         std::vector<double> walls;
         Run r;
         for (int k = 0; k < repeats; ++k) {
@@ -147,11 +148,11 @@ int main(int argc, char** argv) {
        << "set xlabel 'wall time per simulated second [s]'\n"
        << "set ylabel 'max state error at t = 2 s'\nset key outside right\nset grid\n"
        << "set title 'appell: speed against error (tree solver, projection on)'\n"
-       << "scenes = '" << scene_names << "'\nmethods = 'euler rk4 dopri5'\n"
-       << "plot for [i=1:words(scenes)*3] '" << out_dir << "/speed_error.csv' using "
-       << "((strcol(1) eq word(scenes, (i-1)/3+1) && strcol(2) eq word(methods, (i-1)%3+1)) ? $5 : 1/0):6 "
-       << "with linespoints lc (i-1)%3+1 pt (i-1)/3+4 "
-       << "title word(methods, (i-1)%3+1).' / '.word(scenes, (i-1)/3+1)\n";
+       << "scenes = '" << scene_names << "'\nmethods = 'euler rk4 dopri5 dop853'\n"
+       << "plot for [i=1:words(scenes)*4] '" << out_dir << "/speed_error.csv' using "
+       << "((strcol(1) eq word(scenes, (i-1)/4+1) && strcol(2) eq word(methods, (i-1)%4+1)) ? $5 : 1/0):6 "
+       << "with linespoints lc (i-1)%4+1 pt (i-1)/4+4 "
+       << "title word(methods, (i-1)%4+1).' / '.word(scenes, (i-1)/4+1)\n";
     gp.close();
     if (std::system(("gnuplot " + plot).c_str()) == 0)
       std::cout << "figure: " << out_dir << "/speed_error.png\n";

@@ -27,9 +27,11 @@ namespace {
 const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
 
   --duration T        simulated time in seconds (default: the scene's)
-  --dt H              fixed step (euler, leapfrog, rk4), first step (dopri5)
-  --tol TOL           relative tolerance of the adaptive integrator (dopri5);
-                      giving --tol without --integrator selects dopri5
+  --dt H              fixed step (euler, leapfrog, rk4), first step (dopri5,
+                      dop853)
+  --tol TOL           relative tolerance of the adaptive integrators (dopri5,
+                      dop853); giving --tol without --integrator selects
+                      dopri5 unless the scene's integrator is adaptive
   --integrator NAME   {integrators}
   --formulation F     {formulations}   (default: the scene's, else tree)
   --out FILE.csv      write the trajectory (every step, or every --every N)
@@ -174,7 +176,7 @@ void printEvents(std::ostream& out, const RunSummary& r) {
 void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
   const RunOptions& o = r.options;
   const SimulatorCounters& c = r.counters;
-  const bool adaptive = o.integrator == IntegratorType::DormandPrince54;
+  const bool adaptive = adaptiveIntegrator(o.integrator);
   out << std::setprecision(6) << "scene        " << scene.source << "\n"
       << "model        " << scene.model.nbodies << " bodies, nv = " << scene.model.nv << ", "
       << scene.contacts.size() << " contacts, ";
@@ -360,7 +362,8 @@ int run(int argc, char** argv) {
   s.duration = args.positiveNumber("duration", s.duration);
   s.dt = args.positiveNumber("dt", s.dt);
   s.tol = args.positiveNumber("tol", s.tol);
-  if (args.has("tol") && !args.has("integrator"))
+  if (args.has("tol") && !args.has("integrator") &&
+      !adaptiveIntegrator(integratorFromString(s.integrator)))
     s.integrator = toString(IntegratorType::DormandPrince54);
   s.integrator = args.text("integrator", s.integrator);
   s.formulation = args.text("formulation", s.formulation);

@@ -179,7 +179,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   if (on_sample) on_sample(sim);
 
   const auto wall0 = std::chrono::steady_clock::now();
-  const bool adaptive = options.integrator == IntegratorType::DormandPrince54;
+  const bool adaptive = adaptiveIntegrator(options.integrator);
   double h = options.dt;
   long step = 0;
   bool last_sampled = true;

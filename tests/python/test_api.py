@@ -26,7 +26,7 @@ def test_names_and_sizes():
     assert scene.row_kinds == ["tangent1", "tangent2", "normal"]
     assert scene.constraint_rows("rim") == [0, 1, 2] and scene.row_index(0, "normal") == 2
     assert scene.settings.integrator == "dopri5" and scene.settings.duration == 5
-    assert [e["name"] for e in appell.integrators()] == ["euler", "leapfrog", "rk4", "dopri5"]
+    assert [e["name"] for e in appell.integrators()] == ["euler", "leapfrog", "rk4", "dopri5", "dop853"]
     assert "tree" in [f["name"] for f in appell.formulations()]
     assert scene.q0.shape == (7,) and scene.q0.dtype == np.float64
 

@@ -18,6 +18,10 @@
 //                    with rtol/atol and the usual PI-free step controller,
 //                    and Dormand & Prince's 4th-order continuous extension
 //                    as dense output (Hairer, Nørsett, Wanner I, §II.4–6) order 5
+//   DormandPrince853 Hairer's DOP853: 12 stages, FSAL, an order-8 error
+//                    estimate from the 5th- and 3rd-order embedded pairs,
+//                    7th-order dense output from 3 more stages evaluated
+//                    on request (Hairer, Nørsett, Wanner I, §II.10)    order 8
 // A field may also report scalar rates with each evaluation (the powers of the
 // work balance); every method integrates them over the accepted step with its
 // own weights — ∫ p dt as if ṗ-free components of the state, so the work
@@ -75,7 +79,9 @@ class AccelerationField {
   }
 };
 
-enum class IntegratorType { SymplecticEuler, Leapfrog, RK4, DormandPrince54 };
+enum class IntegratorType { SymplecticEuler, Leapfrog, RK4, DormandPrince54, DormandPrince853 };
+/// Whether the method chooses its steps (tol) rather than taking the given h.
+bool adaptiveIntegrator(IntegratorType type);
 /// Every integrator with its names ("euler", "rk4", "dopri5" and their aliases):
 /// the one list that parsing, error messages and the command-line help read.
 std::span<const NamedValue<IntegratorType>> integratorTable();

@@ -88,4 +88,33 @@ class DormandPrince54 final : public Integrator {
   bool dense_ = false;                 // the last call accepted a step: dense output valid
 };
 
+class DormandPrince853 final : public Integrator {
+ public:
+  DormandPrince853(const Model& model, const IntegratorOptions& options);
+  IntegratorType type() const override { return IntegratorType::DormandPrince853; }
+  bool adaptive() const override { return true; }
+  StepResult step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) override;
+  void reset() override { have_fsal_ = false; }
+  void stateMoved(const VecX& dtheta, const VecX& dv) override;
+  /// Evaluates the field three more times (stages 13–15) on the first call
+  /// after a step, with the field that step used.
+  bool denseOutput(double s, VecX& q, VecX& v) override;
+
+ private:
+  void stageState(int s, double h, const VecX& q, const VecX& v);
+  const Model& model_;
+  IntegratorOptions opt_;
+  std::array<VecX, 16> kth_, kv_;       // 12 stages, f(y₁), 3 dense-output stages
+  std::array<StageRates, 13> rates_{};
+  VecX theta_, vs_, qs_, theta1_, v1_, q1_, err5_th_, err5_v_, err3_th_, err3_v_, scale_q_;
+  VecX q_start_, v_start_, dth_, dv_;   // the last accepted step, for dense output
+  std::array<VecX, 4> dsum_;
+  AccelerationField* field_ = nullptr;  // the last accepted step's field
+  double t_start_ = 0, h_last_ = 0;
+  bool have_fsal_ = false;
+  bool fsal_pending_ = false;           // kv_[12] is the next step's k₁, not yet moved
+  bool dense_ = false;                  // the last call accepted a step
+  bool extra_ = false;                  // stages 13–15 of that step evaluated
+};
+
 }  // namespace appell::detail
