@@ -119,11 +119,11 @@ double appellEvaluationSeconds(const sc::BuiltScene& s, int n) {
 
 PeerRun runAppell(const sc::BuiltScene& s, IntegratorType type, const std::string& method, double setting,
                   Formulation form = Formulation::Tree, double* min_axle_z = nullptr) {
-  const bool adaptive = type == IntegratorType::DormandPrince54;
+  const bool adaptive = adaptiveIntegrator(type);
   appell::IntegratorOptions io;
   io.rtol = adaptive ? setting : 1e-8;
   io.atol = io.rtol * 1e-2;
-  io.h_max = 0.1;
+  io.h_max = 1.0;  // the tolerance, not a cap, sets the adaptive steps
   appell::SimulatorOptions so;
   so.evaluate_end_state = false;
   appell::Simulator sim(s.model, s.constraints, appell::makeSolver(form, s.model, s.constraints), type, io, so);
@@ -364,6 +364,7 @@ int main(int argc, char** argv) {
       rows.push_back(r);
     };
     for (double tol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12}) add("appell", "dopri5", tol, false);
+    for (double tol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12}) add("appell", "dop853", tol, false);
     for (double dt : {2e-2, 1e-2, 5e-3, 2e-3, 1e-3}) add("appell", "rk4", dt, false);
     for (double tol : {1e-5, 1e-7, 1e-9}) add("appell", "dopri5-cylinder", tol, true);
 #ifdef PEERS_HAVE_SIMBODY
@@ -384,9 +385,10 @@ int main(int argc, char** argv) {
       const Case& c = *by_name[r.case_name];
       PeerRun run;
       if (r.engine == "appell") {
-        const bool dp = r.method != "rk4";
-        run = runAppell(r.cylinder ? c.cylinder : c.disk, dp ? IntegratorType::DormandPrince54 : IntegratorType::RK4,
-                        r.method, r.setting);
+        const IntegratorType type = r.method == "rk4"      ? IntegratorType::RK4
+                                    : r.method == "dop853" ? IntegratorType::DormandPrince853
+                                                           : IntegratorType::DormandPrince54;
+        run = runAppell(r.cylinder ? c.cylinder : c.disk, type, r.method, r.setting);
       }
 #ifdef PEERS_HAVE_SIMBODY
       if (r.engine == "simbody") run = runSimbody(c.thin, r.method, r.setting);
@@ -507,29 +509,33 @@ int main(int argc, char** argv) {
 
   md << "## Ratios (from this run)\n\n"
      << "Cost at an error: the cheapest run reaching it, interpolated log–log with the next cheaper run "
-     << "(appell: `dopri5` on the thin disk). Error at a cost: log–log between the bracketing `dopri5` runs.\n\n"
+     << "(appell: `dopri5`, and `dop853`, on the thin disk). Error at a cost: log–log between the bracketing "
+     << "runs of that method.\n\n"
      << "| case | comparison | peer | appell | ratio |\n|---|---|---|---|---|\n";
   for (const Case& c : cases) {
-    std::vector<const Row*> ap, merson, mujoco;
+    std::vector<const Row*> ap, ap8, merson, mujoco;
     for (const Row& r : rows) {
       if (r.case_name != c.name) continue;
       if (r.engine == "appell" && r.method == "dopri5") ap.push_back(&r);
+      if (r.engine == "appell" && r.method == "dop853") ap8.push_back(&r);
       if (r.engine == "simbody" && r.method == "merson") merson.push_back(&r);
       if (r.engine == "mujoco") mujoco.push_back(&r);
     }
-    for (double E : {4e-5, 8e-9}) {
-      if (merson.empty()) break;
-      const double cs = costAtError(merson, E), ca = costAtError(ap, E);
-      md << "| " << c.name << " | CPU per simulated s at error " << sci(E, 0) << " m at 10 s | Simbody Merson "
-         << fixed(1e3 * cs, 3) << " ms | " << fixed(1e3 * ca, 3) << " ms | " << fixed(cs / ca, 1)
-         << "× less CPU |\n";
-    }
-    for (const Row* m : mujoco) {
-      if (m->setting != 1e-3) continue;
-      const double ea = errorAtCost(ap, m->perSimSecond());
-      md << "| " << c.name << " | error at 10 s at MuJoCo's cost (" << m->method << ", dt 1e-3, " << fixed(1e3 * m->perSimSecond(), 3)
-         << " ms per simulated s) | MuJoCo " << sci(m->err10) << " m | " << sci(ea) << " m | "
-         << sci(m->err10 / ea, 1) << "× smaller error |\n";
+    for (const auto& [method, mine] : {std::pair{"dopri5", &ap}, std::pair{"dop853", &ap8}}) {
+      for (double E : {4e-5, 8e-9}) {
+        if (merson.empty()) break;
+        const double cs = costAtError(merson, E), ca = costAtError(*mine, E);
+        md << "| " << c.name << " | CPU per simulated s at error " << sci(E, 0) << " m at 10 s | Simbody Merson "
+           << fixed(1e3 * cs, 3) << " ms | " << method << " " << fixed(1e3 * ca, 3) << " ms | " << fixed(cs / ca, 1)
+           << "× less CPU |\n";
+      }
+      for (const Row* m : mujoco) {
+        if (m->setting != 1e-3) continue;
+        const double ea = errorAtCost(*mine, m->perSimSecond());
+        md << "| " << c.name << " | error at 10 s at MuJoCo's cost (" << m->method << ", dt 1e-3, " << fixed(1e3 * m->perSimSecond(), 3)
+           << " ms per simulated s) | MuJoCo " << sci(m->err10) << " m | " << method << " " << sci(ea) << " m | "
+           << sci(m->err10 / ea, 1) << "× smaller error |\n";
+      }
     }
   }
   md << "\n";
@@ -558,7 +564,7 @@ int main(int argc, char** argv) {
        << "set logscale xy\nset format y '1e%L'\nset format x '1e%L'\nset grid\n"
        << "set xlabel 'CPU time per simulated second [s]'\nset ylabel 'centre position error at t = 10 s [m]'\n"
        << "set key outside right\n"
-       << "methods = 'appell/dopri5 appell/rk4 appell/dopri5-cylinder simbody/merson simbody/rk3 mujoco/euler mujoco/euler-noslip'\n"
+       << "methods = 'appell/dopri5 appell/dop853 appell/rk4 appell/dopri5-cylinder simbody/merson simbody/rk3 mujoco/euler mujoco/euler-noslip'\n"
        << "eng(i) = substr(word(methods,i), 1, strstrt(word(methods,i),'/')-1)\n"
        << "met(i) = substr(word(methods,i), strstrt(word(methods,i),'/')+1, strlen(word(methods,i)))\n"
        << "set multiplot layout 1,2\n";

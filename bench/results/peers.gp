@@ -10,7 +10,7 @@ set grid
 set xlabel 'CPU time per simulated second [s]'
 set ylabel 'centre position error at t = 10 s [m]'
 set key outside right
-methods = 'appell/dopri5 appell/rk4 appell/dopri5-cylinder simbody/merson simbody/rk3 mujoco/euler mujoco/euler-noslip'
+methods = 'appell/dopri5 appell/dop853 appell/rk4 appell/dopri5-cylinder simbody/merson simbody/rk3 mujoco/euler mujoco/euler-noslip'
 eng(i) = substr(word(methods,i), 1, strstrt(word(methods,i),'/')-1)
 met(i) = substr(word(methods,i), strstrt(word(methods,i),'/')+1, strlen(word(methods,i)))
 set multiplot layout 1,2

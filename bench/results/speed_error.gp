@@ -12,5 +12,5 @@ set key outside right
 set grid
 set title 'appell: speed against error (tree solver, projection on)'
 scenes = 'rolling_disk sleigh hemisphere_bowl'
-methods = 'euler rk4 dopri5'
-plot for [i=1:words(scenes)*3] 'bench/results/speed_error.csv' using ((strcol(1) eq word(scenes, (i-1)/3+1) && strcol(2) eq word(methods, (i-1)%3+1)) ? $5 : 1/0):6 with linespoints lc (i-1)%3+1 pt (i-1)/3+4 title word(methods, (i-1)%3+1).' / '.word(scenes, (i-1)/3+1)
+methods = 'euler rk4 dopri5 dop853'
+plot for [i=1:words(scenes)*4] 'bench/results/speed_error.csv' using ((strcol(1) eq word(scenes, (i-1)/4+1) && strcol(2) eq word(methods, (i-1)%4+1)) ? $5 : 1/0):6 with linespoints lc (i-1)%4+1 pt (i-1)/4+4 title word(methods, (i-1)%4+1).' / '.word(scenes, (i-1)/4+1)
