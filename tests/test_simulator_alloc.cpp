@@ -274,7 +274,9 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
       if (std::isfinite(mu) && creep == 0) {
         EXPECT_GE(slips, 1) << what << ": a sliding impact";
       }
-      if (creep > 0) EXPECT_EQ(slips, 0) << what << ": a creeping contact never sticks or slips";
+      if (creep > 0) {
+        EXPECT_EQ(slips, 0) << what << ": a creeping contact never sticks or slips";
+      }
       EXPECT_EQ(allocations, 0) << what;
       EXPECT_TRUE(sim.isClosed(0));
     }

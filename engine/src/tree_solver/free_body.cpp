@@ -13,13 +13,21 @@
 //
 // It is taken only where it is that answer. The rows, equilibrated (E K),
 // must be resolved whole by the free joint, which the general passes decide
-// by σ_min(E K) ≥ 1/‖R⁻¹‖_F > kWeakPivot on the compression's triangular
-// factor (backward.cpp, freeSplit); here the same bound is taken on the
-// Cholesky factor of the rows' Gram matrix, E K Kᵀ E = Lg Lgᵀ (Lg is the LQ
-// factor of E K, so σ(E K) = σ(Lg)). Then no row is redundant, μ is unique,
-// and the result agrees with the passes to round-off (tests/test_tree_solver.cpp,
-// AFreeBodysClosedFormIsThePassesAnswer). Anything else — redundant or weak rows, sliding contacts'
-// friction rows (zero rows), more than 6 rows — goes to the passes.
+// by 1/‖R⁻¹‖_F > kWeakPivot on the compression's triangular factor
+// (backward.cpp, freeSplit) — with R the factor of E K's QR, ‖R⁻¹‖_F² =
+// tr((E K Kᵀ E)⁻¹). Here the bound comes from the factor the solve needs
+// anyway, S = YᵀY = E K I⁻¹ Kᵀ E = Ls Lsᵀ: since I⁻¹ ⪯ Id/λ_min(I),
+//     tr(S⁻¹) ≥ λ_min(I) tr((E K Kᵀ E)⁻¹),  so  1/‖R⁻¹‖_F ≥ σ_min(L)/‖Ls⁻¹‖_F,
+// and σ_min(L)/‖Ls⁻¹‖_F > kWeakPivot (σ_min(L) = √λ_min(I), formed once)
+// implies the passes' test. The bound loses up to cond(L) (a 1 g ball of
+// 1 cm: 160), so where it fails the Gram matrix's factor, E K Kᵀ E = Lg Lgᵀ,
+// decides as the passes do: 1/‖Lg⁻¹‖_F = 1/‖R⁻¹‖_F. The closed form thus
+// accepts exactly what the passes resolve whole, and pays for the second
+// factorisation only near the threshold or on such bodies. Then no row is
+// redundant, μ is unique, and the result agrees with the passes to round-off
+// (tests/test_tree_solver.cpp, AFreeBodysClosedFormIsThePassesAnswer).
+// Anything else — redundant or weak rows, sliding contacts' friction rows
+// (zero rows), more than 6 rows — goes to the passes.
 #include "tree_solver/workspace.hpp"
 
 #include <cmath>
@@ -104,15 +112,7 @@ bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& c
     }
   }
 
-  // Resolved whole? The Gram matrix's factor bounds σ_min(E K) from below.
   double inv[6];
-  if (m > 0) {
-    Mat6 G;  // the leading m × m only: the factorisation reads no more
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; j <= i; ++j) G(i, j) = Kt.col(i).dot(Kt.col(j));
-    if (!cholesky(G, m, inv) || !(sigmaMinBound(G, inv, m) > kWeakPivot)) return false;
-  }
-
   // z = L⁻¹ f₀, Y = L⁻¹ Kt, S = Yᵀ Y = E K I⁻¹ Kᵀ E, r = k_e − Yᵀ z (= k_e − E K a₀).
   const Mat6& Linv = ws.free_body_linv;
   Vec6 z = Vec6::Zero();
@@ -129,6 +129,17 @@ bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& c
   }
   if (m > 0) {
     if (!cholesky(S, m, inv)) return false;
+    // Resolved whole? σ_min(L)/‖Ls⁻¹‖_F bounds the passes' test (above).
+    // When it is inconclusive — a small or anisotropic body, where the
+    // bound loses cond(L) — the passes' own quantity decides: the Gram
+    // factor's bound 1/‖Lg⁻¹‖_F.
+    if (!(ws.free_body_sigma * sigmaMinBound(S, inv, m) > kWeakPivot)) {
+      Mat6 G;  // the leading m × m only: the factorisation reads no more
+      double inv_g[6];
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j <= i; ++j) G(i, j) = Kt.col(i).dot(Kt.col(j));
+      if (!cholesky(G, m, inv_g) || !(sigmaMinBound(G, inv_g, m) > kWeakPivot)) return false;
+    }
     choleskySolve(S, inv, m, r);  // r = μ_e
   }
 
