@@ -26,14 +26,10 @@ BuiltScene creepingBall(double mu, double creep, const Vec3& vG, const Vec3& g) 
   BallParams p;
   p.radius = kR;
   p.mass = kM;
-  BuiltScene s = ball(p);
-  ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
-  spec.mu = mu;
-  spec.creep_speed = creep;
-  s.constraints[0] = makeContact(spec);
-  s.model.gravity = g;
-  s.v0 = floatingVelocity(Mat3::Identity(), Vec3::Zero(), vG);
-  return s;
+  p.mu = mu;
+  p.creep_speed = creep;
+  p.omega = Vec3::Zero();
+  return ballWithFriction(p, vG, g);
 }
 
 Vec3 centreVelocity(const Simulator& sim) { return floatingRotation(sim.q(), 0) * Vec3(sim.v().tail<3>()); }

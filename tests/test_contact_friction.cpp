@@ -30,13 +30,9 @@ BuiltScene ballWithFriction(double mu, const Vec3& vG, const Vec3& omega, const 
   BallParams p;
   p.radius = kR;
   p.mass = kM;
-  BuiltScene s = ball(p);
-  ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
-  spec.mu = mu;
-  s.constraints[0] = makeContact(spec);
-  s.model.gravity = g;
-  s.v0 = floatingVelocity(Mat3::Identity(), omega, vG);
-  return s;
+  p.mu = mu;
+  p.omega = omega;
+  return scenes::ballWithFriction(p, vG, g);
 }
 
 Vec3 centreVelocity(const Simulator& sim) { return floatingRotation(sim.q(), 0) * Vec3(sim.v().tail<3>()); }

@@ -44,24 +44,10 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
   StepResult r;
   dense_ = false;
   h = std::min(h, opt_.h_max);
-  // Magnitudes the local coordinates are measured against: the coordinate itself
-  // for Euclidean joints, 1 rad for rotations.
-  for (const Joint& j : model_.joints) {
-    const bool rot = j.type == JointType::Floating || j.type == JointType::Ball;
-    for (int k = 0; k < j.nv; ++k) {
-      const bool euclid = !rot || (j.type == JointType::Floating && k >= 3);
-      scale_q_[j.idx_v + k] = euclid ? std::abs(q[j.idx_q + k - (j.type == JointType::Floating ? 3 : 0)]) : 1.0;
-    }
-  }
-  theta_.setZero();
-  localRate(model_, q, theta_, v, kth_[0]);
-  if (!have_fsal_) {
-    ++r.evaluations;
-    if (!f(t, q, v, kv_[0]) || !kv_[0].allFinite()) {
-      r.ok = false;
-      return r;
-    }
-    readRates(f, rates_[0]);
+  coordinateScales(model_, q, scale_q_);
+  if (!firstStage(model_, f, t, q, v, have_fsal_, theta_, kth_[0], kv_[0], rates_[0], r)) {
+    r.ok = false;
+    return r;
   }
   for (;;) {
     bool field_ok = true;
@@ -141,13 +127,7 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
 // the seventh evaluation of the next step (issue 15, item 3).
 void DormandPrince54::stateMoved(const VecX& dtheta, const VecX& dv) {
   if (!have_fsal_) return;
-  double sum = 0;
-  for (int i = 0; i < model_.nv; ++i) {
-    const double sq = opt_.atol + opt_.rtol * scale_q_[i];
-    const double sv = opt_.atol + opt_.rtol * std::abs(vs_[i]);
-    sum += std::pow(dtheta[i] / sq, 2) + std::pow(dv[i] / sv, 2);
-  }
-  const double moved = model_.nv > 0 ? std::sqrt(sum / (2.0 * model_.nv)) : 0.0;
+  const double moved = scaledMove(opt_, scale_q_, vs_, dtheta, dv);
   if (!(moved <= 1.0)) have_fsal_ = false;
 }
 

@@ -84,13 +84,7 @@ StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX
   StepResult r;
   dense_ = extra_ = false;
   h = std::min(h, opt_.h_max);
-  for (const Joint& j : model_.joints) {  // as dormand_prince.cpp
-    const bool rot = j.type == JointType::Floating || j.type == JointType::Ball;
-    for (int k = 0; k < j.nv; ++k) {
-      const bool euclid = !rot || (j.type == JointType::Floating && k >= 3);
-      scale_q_[j.idx_v + k] = euclid ? std::abs(q[j.idx_q + k - (j.type == JointType::Floating ? 3 : 0)]) : 1.0;
-    }
-  }
+  coordinateScales(model_, q, scale_q_);
   // FSAL: the last step's f(t + h, y₁) is this step's k₁ — moved only now,
   // so that the dense output of the last step could still read its stages.
   if (have_fsal_ && fsal_pending_) {
@@ -98,15 +92,9 @@ StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX
     rates_[0] = rates_[dop853::kStages];
   }
   fsal_pending_ = false;
-  theta_.setZero();
-  localRate(model_, q, theta_, v, kth_[0]);
-  if (!have_fsal_) {
-    ++r.evaluations;
-    if (!f(t, q, v, kv_[0]) || !kv_[0].allFinite()) {
-      r.ok = false;
-      return r;
-    }
-    readRates(f, rates_[0]);
+  if (!firstStage(model_, f, t, q, v, have_fsal_, theta_, kth_[0], kv_[0], rates_[0], r)) {
+    r.ok = false;
+    return r;
   }
   for (;;) {
     bool field_ok = true;
@@ -220,15 +208,7 @@ bool DormandPrince853::denseOutput(double x, VecX& q, VecX& v) {
 
 void DormandPrince853::stateMoved(const VecX& dtheta, const VecX& dv) {
   if (!have_fsal_) return;
-  // As Dormand–Prince 5(4) (dormand_prince.cpp): keep the FSAL stage when
-  // the move is within the error tolerance.
-  double sum = 0;
-  for (int i = 0; i < model_.nv; ++i) {
-    const double sq = opt_.atol + opt_.rtol * scale_q_[i];
-    const double sv = opt_.atol + opt_.rtol * std::abs(v1_[i]);
-    sum += std::pow(dtheta[i] / sq, 2) + std::pow(dv[i] / sv, 2);
-  }
-  const double moved = model_.nv > 0 ? std::sqrt(sum / (2.0 * model_.nv)) : 0.0;
+  const double moved = scaledMove(opt_, scale_q_, v1_, dtheta, dv);
   if (!(moved <= 1.0)) have_fsal_ = false;
 }
 

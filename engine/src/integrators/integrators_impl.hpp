@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include <array>
+#include <cmath>
 
 namespace appell::detail {
 
@@ -17,6 +18,48 @@ using StageRates = std::array<double, AccelerationField::kMaxRates>;
 inline void readRates(const AccelerationField& f, StageRates& out) {
   const int n = f.rateCount();
   for (int i = 0; i < AccelerationField::kMaxRates; ++i) out[i] = i < n ? f.rate(i) : 0.0;
+}
+
+/// The magnitudes the adaptive methods measure local coordinates against:
+/// the coordinate itself for Euclidean joints, 1 rad for rotations.
+inline void coordinateScales(const Model& model, const VecX& q, VecX& scale) {
+  for (const Joint& j : model.joints) {
+    const bool rot = j.type == JointType::Floating || j.type == JointType::Ball;
+    for (int k = 0; k < j.nv; ++k) {
+      const bool euclid = !rot || (j.type == JointType::Floating && k >= 3);
+      scale[j.idx_v + k] = euclid ? std::abs(q[j.idx_q + k - (j.type == JointType::Floating ? 3 : 0)]) : 1.0;
+    }
+  }
+}
+
+/// The scaled RMS size of a move (Δθ, Δv) of the accepted state (θ about
+/// `scale`'s q, v): ≤ 1 is within the error tolerance. The adaptive methods'
+/// stateMoved() keeps the FSAL stage below that.
+inline double scaledMove(const IntegratorOptions& o, const VecX& scale, const VecX& v,
+                         const VecX& dtheta, const VecX& dv) {
+  const int n = static_cast<int>(v.size());
+  double sum = 0;
+  for (int i = 0; i < n; ++i) {
+    const double sq = o.atol + o.rtol * scale[i];
+    const double sv = o.atol + o.rtol * std::abs(v[i]);
+    sum += std::pow(dtheta[i] / sq, 2) + std::pow(dv[i] / sv, 2);
+  }
+  return n > 0 ? std::sqrt(sum / (2.0 * n)) : 0.0;
+}
+
+/// An RKMK step's first stage at (t, q, v): kθ = localRate at θ = 0, and
+/// kv = f(t, q, v) unless carried over from the last step (FSAL). false when
+/// the field refuses the state.
+inline bool firstStage(const Model& model, AccelerationField& f, double t, const VecX& q,
+                       const VecX& v, bool have_fsal, VecX& theta, VecX& kth, VecX& kv,
+                       StageRates& rates, StepResult& r) {
+  theta.setZero();
+  localRate(model, q, theta, v, kth);
+  if (have_fsal) return true;
+  ++r.evaluations;
+  if (!f(t, q, v, kv) || !kv.allFinite()) return false;
+  readRates(f, rates);
+  return true;
 }
 
 class SymplecticEuler final : public Integrator {
