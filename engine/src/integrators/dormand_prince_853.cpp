@@ -155,8 +155,10 @@ StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX
       fsal_pending_ = true;  // kv_[12] becomes the next k₁ once the dense output is done with it
       r.h_taken = h;
       r.error = err;
+      // After a rejection in this call the next step may not grow (Hairer's
+      // dop853.f): the error estimate just failed at a larger step.
       const double grow = err > 0 ? opt_.safety * std::pow(err, -1.0 / 8) : 6.0;
-      r.h_next = std::min(opt_.h_max, h * std::clamp(grow, 0.2, 6.0));
+      r.h_next = std::min(opt_.h_max, h * std::clamp(grow, 0.2, r.rejected > 0 ? 1.0 : 6.0));
       return r;
     }
     ++r.rejected;
