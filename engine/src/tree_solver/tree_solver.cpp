@@ -89,10 +89,11 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   if (ws.free_body) {
     ws.free_body_linv = model.spatial_inertia_factor[0].triangularView<Eigen::Lower>().solve(
         Mat6::Identity());
-    // σ_min(L) = √λ_min(I): the closed form's acceptance bound (free_body.cpp).
+    // λ_min(I) = σ_min(L)²: the closed form's acceptance bound (free_body.cpp).
     const Mat6& L = model.spatial_inertia_factor[0];
     const Mat6 I = L * L.transpose();
-    ws.free_body_sigma = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat6>(I).eigenvalues()[0]));
+    ws.free_body_lambda_min =
+        std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat6>(I).eigenvalues()[0]);
   }
   for (int i = 0; i < model.nbodies; ++i)
     for (int ch : model.children[i]) ws.nodes[i].groups.push_back({Segment::Child, ch, 0});

@@ -275,7 +275,7 @@ struct TreeWorkspace {
   bool free_body = false;                 ///< one body on a floating joint, no loop or joint rows (free_body.cpp)
   bool last_closed_form = false;          ///< the last solve took free_body.cpp's closed form
   Mat6 free_body_linv;                    ///< L⁻¹, I = L Lᵀ the free body's inertia (body frame)
-  double free_body_sigma = 0;             ///< σ_min(L) = √λ_min(I)
+  double free_body_lambda_min = 0;        ///< λ_min(I) = σ_min(L)²
 
   // Solver scratch with compile-time maximum sizes.
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
