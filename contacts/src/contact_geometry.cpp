@@ -32,10 +32,10 @@ void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out) {
   const Vec3& nd = out.normal_rate;
   // u = (1 − n nᵀ) e,  u̇ = ė − ṅ (n·e) − n (ṅ·e + n·ė),  ṫ1 = (1 − t1 t1ᵀ) u̇ / |u|.
   const Vec3 u = e - n * n.dot(e);
-  const double len = u.norm();
-  out.t1 = u / len;
+  const double inv_len = 1.0 / u.norm();
+  out.t1 = u * inv_len;
   const Vec3 ud = edot - nd * n.dot(e) - n * (nd.dot(e) + n.dot(edot));
-  out.t1_rate = (ud - out.t1 * out.t1.dot(ud)) / len;
+  out.t1_rate = (ud - out.t1 * out.t1.dot(ud)) * inv_len;
   out.t2 = n.cross(out.t1);
   out.t2_rate = nd.cross(out.t1) + n.cross(out.t1_rate);
 }

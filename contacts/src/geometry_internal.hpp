@@ -4,6 +4,8 @@
 #include <appell/contact_geometry.hpp>
 #include <appell/overloaded.hpp>
 
+#include <cmath>
+
 namespace appell::detail {
 
 /// World spatial velocity split into its parts.
@@ -23,9 +25,21 @@ void finishPoint(const SE3& pose, const Twist& body, const GaussPoint& g, const 
                  ContactGeometry& out);
 
 /// t1 = normalize((1 − n nᵀ) e), t2 = n × t1 and their rates, for a reference
-/// direction e(t) with rate ė (needs n, ṅ in `out`). Requires |(1 − n nᵀ) e| well
-/// above zero (callers pick e so that it is ≥ 1/√2).
+/// direction e(t) of any length with rate ė (needs n, ṅ in `out`). Requires
+/// |(1 − n nᵀ) e| well above zero relative to |e| (callers pick e so that it
+/// is ≥ |e|/√2).
 void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out);
+
+/// A vector orthogonal to the unit n, in the direction of Eigen's
+/// n.unitOrthogonal() but not normalised (tangentFrame normalises): no
+/// square root on the evaluation path.
+inline Vec3 orthogonal(const Vec3& n) {
+  constexpr double kMuchSmaller = 1e-12;  // Eigen's dummy precision for double
+  if (std::abs(n.x()) > kMuchSmaller * std::abs(n.z()) ||
+      std::abs(n.y()) > kMuchSmaller * std::abs(n.z()))
+    return Vec3(-n.y(), n.x(), 0.0);
+  return Vec3(0.0, -n.z(), n.y());
+}
 
 void planeGeometry(const Shape& shape, const Plane& plane, const SupportState& S, const SE3& pose,
                    const Vec6& V, ContactGeometry& out, const GeometryOptions& opt);

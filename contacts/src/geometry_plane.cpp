@@ -6,12 +6,17 @@
 // the plane; since x is the extreme point along −n, ġ = nᵀ(V_B(x) − V_S(x)).
 #include "geometry_internal.hpp"
 
+#include <cmath>
+#include <limits>
+
 namespace appell::detail {
 
 void planeGeometry(const Shape& shape, const Plane& plane, const SupportState& S, const SE3& pose,
                    const Vec6& V, ContactGeometry& out, const GeometryOptions& opt) {
   const Twist body(V), sup(S.V);
-  const Vec3 nS = plane.normal.normalized();
+  // ShapeContact stores the normal unit; normalise only what arrives otherwise.
+  const double nn = plane.normal.squaredNorm();
+  const Vec3 nS = std::abs(nn - 1.0) <= 8 * std::numeric_limits<double>::epsilon() ? plane.normal : Vec3(plane.normal / std::sqrt(nn));
   const Vec3 n = S.pose.R * nS;
   const Vec3 p0 = S.pose.apply(plane.point);
   const Vec3 m = -(pose.R.transpose() * n);
@@ -23,9 +28,14 @@ void planeGeometry(const Shape& shape, const Plane& plane, const SupportState& S
   const Vec3 mdot = pose.R.transpose() * (body.w - sup.w).cross(n);
   finishPoint(pose, body, g, mdot, out);
 
-  // Reference direction fixed in the support frame, in the plane: t1 turns with the support.
-  const Vec3 e = S.pose.R * nS.unitOrthogonal();
-  tangentFrame(e, sup.w.cross(e), out);
+  // The tangent frame is fixed in the support frame: t1 = R_S ê with ê ⟂ n_S
+  // exactly (orthogonal() swaps components), so no projection is needed, and
+  // both tangents turn with the support, ṫ = Ω × t.
+  const Vec3 eS = orthogonal(nS);
+  out.t1 = S.pose.R * (eS / eS.norm());
+  out.t2 = n.cross(out.t1);
+  out.t1_rate = sup.w.cross(out.t1);
+  out.t2_rate = sup.w.cross(out.t2);
   if (g.singular) markSingular(out, g.reason);
 }
 

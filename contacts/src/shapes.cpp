@@ -252,10 +252,11 @@ GaussPoint torusPoint(const Vec3& c, const Vec3& a, double R, double r, const Ve
     return g;
   }
   g.margin = len;
-  const Vec3 u = pm / len;
-  const Mat3 P = Mat3::Identity() - a * a.transpose();
+  const double inv_len = 1.0 / len;
+  const Vec3 u = pm * inv_len;
   g.y = c + R * u + r * m;
-  g.Sigma = (R / len) * (P - u * u.transpose()) + r * (Mat3::Identity() - m * m.transpose());
+  g.Sigma.noalias() = (R * inv_len) * (Mat3::Identity() - a * a.transpose() - u * u.transpose());
+  if (r != 0) g.Sigma.noalias() += r * (Mat3::Identity() - m * m.transpose());  // r = 0: a disk
   return g;
 }
 
@@ -269,7 +270,7 @@ GaussPoint collisionOnly() {
 }  // namespace
 
 GaussPoint inverseGaussMap(const Shape& shape, const Vec3& m, double tol) {
-  const Mat3 Pm = Mat3::Identity() - m * m.transpose();
+  const auto Pm = [&m] { return Mat3(Mat3::Identity() - m * m.transpose()); };
   return std::visit(
       Overloaded{
           [&](const PointShape& s) {
@@ -280,13 +281,13 @@ GaussPoint inverseGaussMap(const Shape& shape, const Vec3& m, double tol) {
           [&](const Sphere& s) {
             GaussPoint g;
             g.y = s.centre + s.radius * m;
-            g.Sigma = s.radius * Pm;
+            g.Sigma = s.radius * Pm();
             return g;
           },
           [&](const SphericalCap& s) {
             GaussPoint g;
             g.y = s.centre + s.radius * m;
-            g.Sigma = s.radius * Pm;
+            g.Sigma = s.radius * Pm();
             if (m.dot(s.axis) < std::cos(s.half_angle) - tol) {
               g.singular = true;
               g.reason = "contact outside the spherical cap: the body would touch on its rim or "

@@ -35,7 +35,7 @@ void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX
     placeBody(model, data, q, i);
     const Joint& j = model.joints[i];
     const int p = model.parent[i];
-    Vec6 vi = j.S * vSeg(v, j);
+    Vec6 vi = detail::jointMotion(j, vSeg(v, j));
     if (p >= 0) vi += data.liMi[i].actInv(data.v[p]);
     data.v[i] = vi;
   }
@@ -55,8 +55,8 @@ void forwardKinematics(const Model& model, Data& data, const VecX& q, const VecX
     placeBody(model, data, q, i);
     const Joint& j = model.joints[i];
     const int p = model.parent[i];
-    const Vec6 vJ = j.S * vSeg(v, j);
-    Vec6 vi = vJ, ai = j.S * vSeg(a, j);
+    const Vec6 vJ = detail::jointMotion(j, vSeg(v, j));
+    Vec6 vi = vJ, ai = detail::jointMotion(j, vSeg(a, j));
     if (p >= 0) {
       vi += data.liMi[i].actInv(data.v[p]);
       ai += data.liMi[i].actInv(data.a[p]);

@@ -34,4 +34,13 @@ SE3 jointTransform(const Joint& j, const QSeg& q) {
   return X;
 }
 
+/// S x for the joint's motion subspace S and x one of its velocity-like
+/// segments. A floating joint's S is the identity (model.cpp): its product
+/// is a copy, not a 6 × 6 dynamic-size one.
+template <typename Seg>
+Vec6 jointMotion(const Joint& j, const Seg& x) {
+  if (j.type == JointType::Floating) return Vec6(x);
+  return j.S * x;
+}
+
 }  // namespace appell::detail
