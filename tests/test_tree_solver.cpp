@@ -462,14 +462,39 @@ TEST(TreeSolver, InconsistentLoopRowsAreAnErrorNamingThem) {
 // or weak rows go to the passes. Both must give the passes' answer: v̇, λ and
 // Aᵀλ to round-off, and the velocity projection too — and the closed form
 // must actually be taken for the well-posed cases (else this tests nothing).
+// Every other case scales its rows by up to 10⁴ either way, and some make two
+// rows nearly dependent: the closed form factors the rows unequilibrated and
+// equilibrates only its acceptance test, so it must decide as the passes do
+// whatever the scales — exactly when the equilibrated rows' tr((E K Kᵀ E)⁻¹)
+// is below 1/kWeakPivot² (the free split's test, kWeakPivot = 5e-2) — and
+// solve as they do.
 TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
   std::mt19937 rng(31);
   SolverOptions passes_only;
   passes_only.free_body_closed_form = false;
-  int closed = 0, fallback = 0;
+  int closed = 0, fallback = 0, closed_scaled = 0, weak_closed = 0, weak_passes = 0;
+  std::uniform_real_distribution<double> decades(-4.0, 4.0);
   for (int rep = 0; rep < 300; ++rep) {
     // One constraint of 1–6 rows, sometimes with duplicates (redundant: the passes).
     System s = randomSystem(1, true, rng, RowRecipe{rep % 3 == 0 ? 0.3 : 0.0, 0.0, 1});
+    // Near-dependent rows, either side of the threshold: row 1 → row 0 + δ row 1.
+    const bool weak = rep % 4 == 1 && rep % 3 != 0 && !s.local.empty() && s.local[0]->rows() >= 2;
+    if (weak) {
+      Rows& K = s.local[0]->rowsA();
+      K.row(1) = K.row(0) + std::pow(10.0, -2.5 * std::uniform_real_distribution<double>(0, 1)(rng)) * K.row(1);
+    }
+    // The passes' test on the body-frame rows, densely (a margin keeps
+    // round-off off the boundary).
+    double weak_test = 0;  // kWeakPivot² tr((E K Kᵀ E)⁻¹): < 1 resolves whole
+    if (!s.local.empty()) {
+      MatX EK = s.local[0]->rowsA();
+      for (int r = 0; r < EK.rows(); ++r) EK.row(r).normalize();
+      weak_test = 25e-4 * MatX(EK * EK.transpose()).inverse().trace();
+    }
+    const bool scaled = rep % 2 == 1;
+    if (scaled)
+      for (auto& c : s.local)
+        for (int r = 0; r < c->rows(); ++r) c->scaleRow(r, std::pow(10.0, decades(rng)));
     const ConstraintList list = s.list();
     Data data(s.model);
     ConstraintData cd(s.model, list);
@@ -481,6 +506,11 @@ TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
     ASSERT_TRUE(a.ok && b.ok) << a.error << b.error;
     EXPECT_FALSE(slow.lastSolveClosedForm());
     (fast.lastSolveClosedForm() ? closed : fallback)++;
+    if (scaled && fast.lastSolveClosedForm()) ++closed_scaled;
+    if (weak && std::abs(weak_test - 1) > 1e-6) {
+      EXPECT_EQ(fast.lastSolveClosedForm(), weak_test < 1) << "rep " << rep << ": " << weak_test;
+      ++(weak_test < 1 ? weak_closed : weak_passes);
+    }
     EXPECT_LT(relErr(a.vdot, b.vdot), 1e-11) << "rep " << rep;
     EXPECT_LT(relErr(a.lambda, b.lambda), 1e-11) << "rep " << rep;
     EXPECT_LT(relErr(a.reaction, b.reaction), 1e-11) << "rep " << rep;
@@ -498,5 +528,8 @@ TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
     EXPECT_LT(relErr(ma, mb), 1e-11) << "rep " << rep;
   }
   EXPECT_GT(closed, 100);
+  EXPECT_GT(closed_scaled, 50);
+  EXPECT_GT(weak_closed, 5);
+  EXPECT_GT(weak_passes, 5);
   EXPECT_GT(fallback, 20);
 }

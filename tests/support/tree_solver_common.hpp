@@ -35,6 +35,14 @@ class LocalRows : public Constraint {
 
   VecX& kappa() { return kappa_; }
   VecX& bvel() { return bvel_; }
+  Rows& rowsA() { return Ka_; }
+  /// Row r (its covectors, κ and b) times s: the same constraint, rescaled.
+  void scaleRow(int r, double s) {
+    Ka_.row(r) *= s;
+    if (Kb_.rows() > r) Kb_.row(r) *= s;
+    kappa_[r] *= s;
+    bvel_[r] *= s;
+  }
 
  private:
   std::string name_;

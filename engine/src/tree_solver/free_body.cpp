@@ -7,28 +7,29 @@
 // K I⁻¹ Kᵀ = Yᵀ Y and a = L⁻ᵀ(L⁻¹ f₀ + Y μ). I is constant in the body's
 // frame, so L⁻¹ is formed once (TreeSolver's constructor) and a solve is
 // m + 2 fixed-size 6 × 6 matrix-vector products and an m × m LDLᵀ
-// factorisation (m ≤ 6 rows; no square roots): the general passes' answer without their dynamic-size
-// machinery (compression, split, articulated inertia) and without the
-// division chains of 6 × 6 triangular solves.
+// factorisation (m ≤ 6 rows): the general passes' answer without their
+// dynamic-size machinery (compression, split, articulated inertia), and
+// without a square root — their latency, not the flops, bounded this path.
 //
-// It is taken only where it is that answer. The rows, equilibrated (E K),
-// must be resolved whole by the free joint, which the general passes decide
-// by 1/‖R⁻¹‖_F > kWeakPivot on the compression's triangular factor
-// (backward.cpp, freeSplit) — with R the factor of E K's QR, ‖R⁻¹‖_F² =
-// tr((E K Kᵀ E)⁻¹). Here the bound comes from the factor the solve needs
-// anyway, S = YᵀY = E K I⁻¹ Kᵀ E = L D Lᵀ: since I⁻¹ ⪯ Id/λ_min(I),
-//     tr(S⁻¹) ≥ λ_min(I) tr((E K Kᵀ E)⁻¹),  so  ‖R⁻¹‖_F² ≤ tr(S⁻¹)/λ_min(I),
-// and λ_min(I) > kWeakPivot² tr(S⁻¹) (λ_min(I) formed once, tr(S⁻¹) from
-// L and D) implies the passes' test. The bound loses up to cond(I) (a 1 g
-// ball of 1 cm: 160²), so where it fails the Gram matrix's factor,
-// E K Kᵀ E = Lg Dg Lgᵀ, decides as the passes do: tr(G⁻¹) = ‖R⁻¹‖_F².
-// The closed form thus
-// accepts exactly what the passes resolve whole, and pays for the second
-// factorisation only near the threshold or on such bodies. Then no row is
-// redundant, μ is unique, and the result agrees with the passes to round-off
-// (tests/test_tree_solver.cpp, AFreeBodysClosedFormIsThePassesAnswer).
-// Anything else — redundant or weak rows, sliding contacts' friction rows
-// (zero rows), more than 6 rows — goes to the passes.
+// It is taken only where it is that answer. The rows, equilibrated (E K,
+// E = diag(1/‖kᵢ‖)), must be resolved whole by the free joint, which the
+// general passes decide by 1/‖R⁻¹‖_F > kWeakPivot on the compression's
+// triangular factor (backward.cpp, freeSplit) — with R the factor of E K's
+// QR, ‖R⁻¹‖_F² = tr((E K Kᵀ E)⁻¹). Here the bound comes from the factor the
+// solve needs anyway, S = YᵀY = K I⁻¹ Kᵀ = L D Lᵀ: since I⁻¹ ⪯ Id/λ_min(I),
+//     tr((E S E)⁻¹) ≥ λ_min(I) tr((E K Kᵀ E)⁻¹),
+// so λ_min(I) > kWeakPivot² tr((E S E)⁻¹) implies the passes' test
+// (λ_min(I) is formed once; tr((E S E)⁻¹) = Σᵢ ‖kᵢ‖² (S⁻¹)ᵢᵢ needs L, D and
+// the rows' squared norms only). The bound loses up to cond(I) (a 1 g ball
+// of 1 cm: 160²), so where it fails the Gram matrix K Kᵀ, factored the same
+// way, decides as the passes do: tr((E K Kᵀ E)⁻¹) = ‖R⁻¹‖_F². The closed
+// form thus accepts exactly what the passes resolve whole, and pays for the
+// second factorisation only near the threshold or on such bodies. Then no
+// row is redundant, λ is unique, and the result agrees with the passes to
+// round-off (tests/test_tree_solver.cpp,
+// AFreeBodysClosedFormIsThePassesAnswer). Anything else — redundant or weak
+// rows, sliding contacts' friction rows (zero rows), more than 6 rows — goes
+// to the passes.
 #include "tree_solver/workspace.hpp"
 
 #include <cmath>
@@ -66,20 +67,22 @@ void ldltSolve(const Mat6& l, const double inv_d[6], int n, double* x) {
     for (int k = i + 1; k < n; ++k) x[i] -= l(k, i) * x[k];
 }
 
-/// tr(S⁻¹) = tr(D⁻¹ L⁻¹ L⁻ᵀ) = Σᵢⱼ (L⁻¹)ᵢⱼ²/dᵢ for S = L D Lᵀ: the
-/// ‖Ls⁻¹‖_F² of the Cholesky factor Ls = L D^½.
-double inverseTrace(const Mat6& l, const double inv_d[6], int n) {
+/// tr(E⁻¹ S⁻¹ E⁻¹) = Σᵢ (S⁻¹)ᵢᵢ/eᵢ² for S = L D Lᵀ and a diagonal E given
+/// as w2ᵢ = 1/eᵢ², with (S⁻¹)ᵢᵢ = Σⱼ (L⁻¹)ⱼᵢ²/dⱼ: the trace of the inverse of
+/// the equilibrated matrix E S E, without forming E (no square roots).
+double equilibratedInverseTrace(const Mat6& l, const double inv_d[6], const double w2[6], int n) {
   double tr = 0;
   for (int c = 0; c < n; ++c) {  // column c of L⁻¹ (unit lower triangular)
     double x[6];
     x[c] = 1.0;
-    tr += inv_d[c];
+    double diag = inv_d[c];
     for (int r = c + 1; r < n; ++r) {
       double s = 0;
       for (int k = c; k < r; ++k) s -= l(r, k) * x[k];
       x[r] = s;
-      tr += s * s * inv_d[r];
+      diag += s * s * inv_d[r];
     }
+    tr += w2[c] * diag;
   }
   return tr;
 }
@@ -88,11 +91,13 @@ double inverseTrace(const Mat6& l, const double inv_d[6], int n) {
 
 bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& cdata,
                    TreeWorkspace& ws, bool impulse) {
-  // The rows in the body frame, equilibrated, as the columns of Kt = (E K)ᵀ
-  // (the first m of them); k_e = E k. A world covector (n, f) is (Rᵀ(n − p × f), Rᵀf)
-  // in the body frame.
+  // The rows in the body frame as the columns of Kt = Kᵀ (the first m of
+  // them): a world covector (n, f) is (Rᵀ(n − p × f), Rᵀf) there. Their
+  // squared norms w2 = 1/eᵢ² give the equilibration E, which only the
+  // acceptance test needs (the LDLᵀ solve is invariant under diagonal
+  // scaling: van der Sluis 1969).
   Mat6 Kt;
-  double k[6], e[6];
+  double k[6], w2[6];
   int global[6];
   int m = 0;
   const Mat3 Rt = data.oMi[0].R.transpose();
@@ -103,21 +108,20 @@ bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& c
     const RowBlock& blk = cdata.blocks[tb.constraint];
     const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
     for (int r = 0; r < tb.rows; ++r, ++m) {
-      const Vec3 n = W.row(r).head<3>().transpose(), f = W.row(r).tail<3>().transpose();
+      const Vec3 n = tb.sign * W.row(r).head<3>().transpose();
+      const Vec3 f = tb.sign * W.row(r).tail<3>().transpose();
       Kt.col(m).head<3>().noalias() = Rt * (n - p.cross(f));
       Kt.col(m).tail<3>().noalias() = Rt * f;
-      const double nn = Kt.col(m).squaredNorm();
-      if (!(nn > ws.options.rank_abs_tol * ws.options.rank_abs_tol))
+      w2[m] = Kt.col(m).squaredNorm();
+      if (!(w2[m] > ws.options.rank_abs_tol * ws.options.rank_abs_tol))
         return false;  // a zero row: the passes drop it
-      e[m] = 1.0 / std::sqrt(nn);
-      Kt.col(m) *= tb.sign * e[m];
-      k[m] = e[m] * tb.rhs[r];
+      k[m] = tb.rhs[r];
       global[m] = tb.global + r;
     }
   }
 
   double inv_d[6];
-  // z = L⁻¹ f₀, Y = L⁻¹ Kt, S = Yᵀ Y = E K I⁻¹ Kᵀ E, r = k_e − Yᵀ z (= k_e − E K a₀).
+  // z = L⁻¹ f₀, Y = L⁻¹ Kt, S = Yᵀ Y = K I⁻¹ Kᵀ, r = k − Yᵀ z (= k − K a₀).
   const Mat6& Linv = ws.free_body_linv;
   Vec6 z = Vec6::Zero();
   if (!impulse) {
@@ -133,30 +137,31 @@ bool freeBodySolve(const Model& model, const Data& data, const ConstraintData& c
   }
   if (m > 0) {
     if (!ldlt(S, m, inv_d)) return false;
-    // Resolved whole? σ_min(L)/‖Ls⁻¹‖_F bounds the passes' test (above),
-    // compared squared: λ_min(I) > kWeakPivot² tr(S⁻¹). When it is
-    // inconclusive — a small or anisotropic body, where the bound loses
-    // cond(L) — the passes' own quantity decides: the Gram factor's
-    // 1/‖Lg⁻¹‖_F, i.e. 1 > kWeakPivot² tr(G⁻¹).
+    // Resolved whole? σ_min(L)/‖(E S E)⁻½‖_F bounds the passes' test
+    // (above), compared squared: λ_min(I) > kWeakPivot² tr((E S E)⁻¹). When
+    // it is inconclusive — a small or anisotropic body, where the bound
+    // loses cond(I) — the passes' own quantity decides: the equilibrated
+    // Gram matrix's tr((E K Kᵀ E)⁻¹) = ‖R⁻¹‖_F² < 1/kWeakPivot².
     constexpr double kWeak2 = kWeakPivot * kWeakPivot;
-    if (!(ws.free_body_lambda_min > kWeak2 * inverseTrace(S, inv_d, m))) {
+    if (!(ws.free_body_lambda_min > kWeak2 * equilibratedInverseTrace(S, inv_d, w2, m))) {
       Mat6 G;  // the leading m × m only: the factorisation reads no more
       double inv_g[6];
       for (int i = 0; i < m; ++i)
         for (int j = 0; j <= i; ++j) G(i, j) = Kt.col(i).dot(Kt.col(j));
-      if (!ldlt(G, m, inv_g) || !(1.0 > kWeak2 * inverseTrace(G, inv_g, m))) return false;
+      if (!ldlt(G, m, inv_g) || !(1.0 > kWeak2 * equilibratedInverseTrace(G, inv_g, w2, m)))
+        return false;
     }
-    ldltSolve(S, inv_d, m, r);  // r = μ_e
+    ldltSolve(S, inv_d, m, r);  // r = μ = λ
   }
 
-  // a = L⁻ᵀ(z + Y μ_e); λ = E μ_e (the force on the body is K_eᵀ μ_e = Kᵀ E μ_e).
+  // a = L⁻ᵀ(z + Y λ).
   for (int i = 0; i < m; ++i) z += r[i] * Y.col(i);
   const Vec6 a = Linv.transpose() * z;
   // Gravity-shifted (ABA's trick): q̈ = a − ᵖXᵢ a_world; a free joint's
   // velocity product v × S q̇ = v × v is zero.
   ws.vdot.head<6>() = a - data.liMi[0].actInv(ws.a_world);
   ws.lambda.setZero();
-  for (int i = 0; i < m; ++i) ws.lambda[global[i]] = e[i] * r[i];
+  for (int i = 0; i < m; ++i) ws.lambda[global[i]] = r[i];
   ws.redundant = 0;
   ws.loop_rank = 0;
   return true;
