@@ -533,3 +533,89 @@ TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
   EXPECT_GT(weak_passes, 5);
   EXPECT_GT(fallback, 20);
 }
+
+// The factor of the backward pass depends on the configuration and the rows
+// only, so a solve or projection at the same ones reuses it
+// (FactorRecord): an integrator stage's factor serves the projection after
+// the step and the end-of-step solve. Reused, it must give bit for bit what a
+// fresh solver gives — with redundant and immobile rows (minimum norm), loop
+// rows, a joint row that locks a joint, a constraint opened and closed, and
+// a new configuration — and it must be reused exactly when nothing changed.
+TEST(TreeSolver, AReusedFactorIsBitForBitAFreshOne) {
+  std::mt19937 rng(41);
+  SolverOptions opt;
+  opt.free_body_closed_form = false;  // one floating body must use the passes too
+  int reused = 0;
+  for (int n : {1, 5, 20}) {
+    for (bool floating : {false, true}) {
+      System s = randomSystem(n, floating, rng, RowRecipe{0.2, 0.2, 1});
+      std::uniform_int_distribution<int> body(0, n - 1);
+      {  // at least one constraint, first in the list: the one opened below
+        Rows K(2, 6);
+        K.row(0) = randomRow(rng).transpose();
+        K.row(1) = randomRow(rng).transpose();
+        s.local.insert(s.local.begin(), std::make_shared<LocalRows>("own", body(rng), K));
+      }
+      if (n > 1) {
+        Rows Ka(1, 6), Kb(1, 6);
+        Ka.row(0) = randomRow(rng).transpose();
+        Kb.row(0) = randomRow(rng).transpose();
+        s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
+      }
+      if (!floating)  // a row on the one velocity of a revolute joint: it locks that joint
+        s.joint.push_back(std::make_shared<JointRows>("lock", MatX::Constant(1, 1, 2.0),
+                                                      std::vector<int>{s.model.nv - 1}));
+      makeConsistent(s, rng);
+      const ConstraintList list = s.list();
+      Data data(s.model);
+      ConstraintData cd(s.model, list);
+      TreeSolver solver(s.model, list, opt);
+      auto same = [&](const VecX& q, const VecX& v, const char* what) -> bool {
+        evaluateConstraints(s.model, data, list, cd, 0.0, q, v);
+        TreeSolver fresh(s.model, list, opt);
+        ConstrainedResult a, b;
+        solver.solve(s.model, data, list, cd, q, v, s.tau, a);
+        fresh.solve(s.model, data, list, cd, q, v, s.tau, b);
+        if (!(a.ok && b.ok)) {
+          ADD_FAILURE() << what << ": " << a.error << b.error;
+          return false;
+        }
+        EXPECT_TRUE(a.vdot == b.vdot) << what << " n=" << n;
+        EXPECT_TRUE(a.lambda == b.lambda) << what << " n=" << n;
+        EXPECT_TRUE(a.reaction == b.reaction) << what << " n=" << n;
+        EXPECT_EQ(a.redundant, b.redundant) << what;
+        EXPECT_FALSE(fresh.lastFactorReused());
+        return solver.lastFactorReused();
+      };
+      // Solves at the velocities the rows were made consistent for (immobile
+      // rows' right sides hold only there), projections at any.
+      const VecX v2 = randomVector(s.model.nv, rng);
+      EXPECT_FALSE(same(s.q, s.v, "first solve"));
+      // A projection at the same pose (other velocities: the covectors do not change).
+      evaluateConstraints(s.model, data, list, cd, 0.0, s.q, v2);
+      VecX va = v2, vb = v2, ma, mb;
+      TreeSolver fresh(s.model, list, opt);
+      ASSERT_TRUE(solver.projectVelocity(s.model, data, list, cd, s.q, va, ma)) << solver.lastError();
+      ASSERT_TRUE(fresh.projectVelocity(s.model, data, list, cd, s.q, vb, mb)) << fresh.lastError();
+      EXPECT_TRUE(solver.lastFactorReused());
+      EXPECT_TRUE(va == vb && ma == mb) << "projection n=" << n;
+      // A solve at other velocities (right sides made consistent there): the
+      // factor is reused, the velocity products are new.
+      s.v = randomVector(s.model.nv, rng);
+      makeConsistent(s, rng);
+      EXPECT_TRUE(same(s.q, s.v, "solve at other velocities"));
+      // Open the first constraint: other rows, a new factor; close it again.
+      cd.setActive(0, false);
+      EXPECT_FALSE(same(s.q, s.v, "constraint 0 open"));
+      cd.setActive(0, true);
+      EXPECT_FALSE(same(s.q, s.v, "constraint 0 closed again"));
+      // Another configuration (its rows' right sides made consistent there).
+      s.q[s.model.nq - 1] += 0.1;
+      if (floating) s.q.segment<4>(3).normalize();
+      makeConsistent(s, rng);
+      EXPECT_FALSE(same(s.q, s.v, "new configuration"));
+      reused += same(s.q, s.v, "same configuration again") ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(reused, 6);
+}

@@ -108,6 +108,9 @@ double appellEvaluationSeconds(const sc::BuiltScene& s, int n) {
   for (int k = 0; k < n; ++k) {
     const double t0 = cpuSeconds();
     for (int i = 0; i < per; ++i) {
+      // As at a new state: the rows' forward kinematics always run; the tree
+      // solver must not reuse the previous call's factor either.
+      if (auto* tree = dynamic_cast<appell::TreeSolver*>(solver.get())) tree->forgetFactor();
       appell::evaluateConstraintRows(s.model, data, s.constraints, cd, 0.0, s.q0, s.v0);
       solver->solve(s.model, data, s.constraints, cd, s.q0, s.v0, tau, res,
                     appell::SolveOutputs::Accelerations);

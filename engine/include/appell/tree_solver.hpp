@@ -71,6 +71,14 @@ class TreeSolver : public ConstrainedSolver {
   /// Whether the last solve or projection took the one-free-body closed form
   /// (tree_solver/free_body.cpp) rather than the passes.
   bool lastSolveClosedForm() const;
+  /// Whether the last solve or projection reused the factor of an earlier
+  /// one at the same configuration and rows (no backward factor pass: a
+  /// projection at an integrator stage's pose, the end-of-step solve after
+  /// it). The answer is bit for bit the one a fresh factor gives.
+  bool lastFactorReused() const;
+  /// Forgets the recorded factor: the next solve or projection forms it
+  /// anew. For benchmarks that time whole solves at one state.
+  void forgetFactor();
   const std::string& lastError() const override;
 
  private:

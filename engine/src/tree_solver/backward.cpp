@@ -338,7 +338,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     // 3. Articulated inertia: a = P ā + d + S₂ z with P = 1 − S G⁺ K; the free
     //    part z is eliminated as in ABA, and the parent sees H = Pᵀ Ia P — the
     //    particular/free coupling the constrained-LQR equations drop.
-    Mat6 H;
+    Mat6& H = nd.H;
     nd.soft = false;
     nd.softpass = false;
     // Closed joint-space rows on this joint lock it (tree_solver/locked.cpp).
@@ -367,11 +367,47 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       ws.redundant += nd.nfree;
       ws.seeds[ws.nseeds++] = i;
     }
-    if (nd.npass > 0) nd.kpc.noalias() = nd.Kpass * nd.c;  // for the bias pass
-    if (p >= 0) {
-      nd.Hc.noalias() = H * nd.c;  // the velocity-product term of the bias pass
-      addCongruence(data.liMi[i], H, ws.nodes[p].IA);
+    if (p >= 0) addCongruence(data.liMi[i], H, ws.nodes[p].IA);
+  }
+}
+
+void factorPassIfChanged(const Model& model, const Data& data, const ConstraintData& cdata,
+                         const VecX& q, TreeWorkspace& ws) {
+  FactorRecord& rec = ws.factor_record;
+  int n = 0;
+  for (const TreeBlock& tb : ws.blocks) {
+    rec.next[n++] = tb.rows;
+    const RowBlock& blk = cdata.blocks[tb.constraint];
+    const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
+    for (int r = 0; r < tb.rows; ++r)
+      for (int c = 0; c < 6; ++c) rec.next[n++] = W(r, c);
+  }
+  for (int b : ws.jrow_nodes)
+    for (const JointRow& jr : ws.nodes[b].jrows) {
+      const bool active = cdata.isActive(jr.constraint);
+      rec.next[n++] = active ? 1.0 : 0.0;
+      rec.next[n++] = active ? cdata.blocks[jr.constraint].A_joint(jr.row, 0) : 0.0;
     }
+  const bool same = rec.valid && n == rec.length && rec.q == q &&
+                    std::equal(rec.next.begin(), rec.next.begin() + n, rec.rows.begin());
+  ws.last_factor_reused = same;
+  if (same) {
+    ws.redundant = rec.redundant;  // what factorPass set; the callers add to it
+    return;
+  }
+  factorPass(model, data, cdata, ws);
+  std::swap(rec.rows, rec.next);  // same capacity: no allocation
+  rec.length = n;
+  rec.q = q;
+  rec.redundant = ws.redundant;
+  rec.valid = true;
+}
+
+void velocityCouplings(const Model& model, TreeWorkspace& ws) {
+  for (int i = 0; i < model.nbodies; ++i) {
+    Node& nd = ws.nodes[i];
+    if (nd.npass > 0) nd.kpc.noalias() = nd.Kpass * nd.c;
+    if (model.parent[i] >= 0) nd.Hc.noalias() = nd.H * nd.c;
   }
 }
 

@@ -80,6 +80,14 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
     global += rows;
   }
   ws.m = global;
+  {  // the factor's record (workspace.hpp, FactorRecord) at its largest
+    int length = 0;
+    for (const auto& tb : ws.blocks) length += 1 + 6 * tb.declared;
+    for (int b : ws.jrow_nodes) length += 2 * static_cast<int>(ws.nodes[b].jrows.size());
+    ws.factor_record.rows.assign(length, 0.0);
+    ws.factor_record.next.assign(length, 0.0);
+    ws.factor_record.q = VecX::Zero(model.nq);
+  }
   std::sort(ws.jrow_nodes.begin(), ws.jrow_nodes.end());
   // One free body (tree_solver/free_body.cpp) with a positive definite
   // inertia: L⁻¹ of its constant factor I = L Lᵀ, formed once.
@@ -145,6 +153,8 @@ TreeSolver::~TreeSolver() = default;
 int TreeSolver::loopRows() const { return static_cast<int>(ws_->loops.size()); }
 int TreeSolver::redundantRows() const { return ws_->last_redundant; }
 bool TreeSolver::lastSolveClosedForm() const { return ws_->last_closed_form; }
+bool TreeSolver::lastFactorReused() const { return ws_->last_factor_reused; }
+void TreeSolver::forgetFactor() { ws_->factor_record.valid = false; }
 const std::string& TreeSolver::lastError() const { return ws_->last_error; }
 
 namespace {
@@ -219,6 +229,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   out.error.clear();
   ws.last_error.clear();
   ws.last_closed_form = false;
+  ws.last_factor_reused = false;
   if (cdata.singular) {
     out.ok = false;
     out.error = "singular constraint geometry: " + cdata.singular_reason;
@@ -245,7 +256,8 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
     return;
   }
   velocityTerms(model, data, v, ws);
-  detail::factorPass(model, data, cdata, ws);
+  detail::factorPassIfChanged(model, data, cdata, q, ws);
+  detail::velocityCouplings(model, ws);
   ws.use_c = true;
   ws.lambda.setZero();
   detail::loopTargets(model, data, cdata, ws, v, false);
@@ -269,6 +281,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
   const int open_loops = applyActiveSet(cdata, ws, zero_rows);
   ws.last_error.clear();
   ws.last_closed_form = false;
+  ws.last_factor_reused = false;
   if (cdata.singular) {
     ws.last_error = "singular constraint geometry: " + cdata.singular_reason;
     return false;
@@ -293,7 +306,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
   ws.a_world.setZero();
   ws.last_closed_form = ws.free_body && detail::freeBodySolve(model, data, cdata, ws, true);
   if (!ws.last_closed_form) {
-    detail::factorPass(model, data, cdata, ws);
+    detail::factorPassIfChanged(model, data, cdata, q, ws);
     for (auto& nd : ws.nodes) nd.bias0.setZero();
     ws.use_c = false;
     ws.lambda.setZero();

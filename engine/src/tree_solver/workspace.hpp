@@ -226,6 +226,7 @@ struct Node {
 
   std::vector<Segment> groups;            ///< own blocks, then children
   std::vector<Compression> comp;          ///< sized groups.size() + 1
+  Mat6 H;                                 ///< Pᵀ Ia P, what the parent sees (velocityCouplings)
 };
 
 /// y = U₂ᵀ x: right sides of the rows handed to the parent.
@@ -263,6 +264,19 @@ struct Failure {
   double residual = 0;
 };
 
+/// What the passes' factor (factorPass) was formed from, by value: the
+/// configuration (the kinematics are forwardKinematics(q)'s) and, after the
+/// active set, each block's row count and covectors and each joint row's
+/// state. The model is the one the solver was built for (immutable, as for
+/// the constructor's own precomputations). Sized by the constructor.
+struct FactorRecord {
+  bool valid = false;
+  VecX q;
+  std::vector<double> rows, next;  ///< the record, and this call's (swapped in)
+  int length = 0;
+  int redundant = 0;               ///< factorPass's redundancy count
+};
+
 struct TreeWorkspace {
   std::vector<int> unilateral_row;          ///< per constraint: Constraint::unilateralRow()
   SolverOptions options;
@@ -276,6 +290,8 @@ struct TreeWorkspace {
   bool last_closed_form = false;          ///< the last solve took free_body.cpp's closed form
   Mat6 free_body_linv;                    ///< L⁻¹, I = L Lᵀ the free body's inertia (body frame)
   double free_body_lambda_min = 0;        ///< λ_min(I) = σ_min(L)²
+  FactorRecord factor_record;             ///< factorPassIfChanged
+  bool last_factor_reused = false;        ///< the last solve / projection skipped factorPass
 
   // Solver scratch with compile-time maximum sizes.
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
@@ -337,6 +353,16 @@ inline void gatherRhs(const TreeWorkspace& ws, int i, int e, BufVec& r) {
 // Passes (tree_solver/backward.cpp, tree_solver/forward.cpp, tree_solver/loops.cpp).
 void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
                 TreeWorkspace& ws);
+/// factorPass, unless ws already holds the factor of this q and these rows
+/// (FactorRecord): a projection at a stage's pose, or the end-of-step solve
+/// after it, reuses that stage's factor. The result is bit for bit the same.
+/// `data` must hold the kinematics of q.
+void factorPassIfChanged(const Model& model, const Data& data, const ConstraintData& cdata,
+                         const VecX& q, TreeWorkspace& ws);
+/// The velocity-product terms of the bias pass, H c and Kpass c, from the
+/// factor and the nodes' c (velocityTerms): a dynamics solve needs them, a
+/// projection (no velocity products) does not.
+void velocityCouplings(const Model& model, TreeWorkspace& ws);
 /// Right-side pass; with `check`, returns false (ws.failure) on inconsistent rows.
 bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check);
 /// Accelerations and multipliers (ws.vdot, ws.lambda for tree rows); with
