@@ -539,8 +539,10 @@ TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
 // (FactorRecord): an integrator stage's factor serves the projection after
 // the step and the end-of-step solve. Reused, it must give bit for bit what a
 // fresh solver gives — with redundant and immobile rows (minimum norm), loop
-// rows, a joint row that locks a joint, a constraint opened and closed, and
-// a new configuration — and it must be reused exactly when nothing changed.
+// rows between bodies and over v (whose unit responses and their SVD are
+// kept with the factor), a joint row that locks a joint, a constraint opened
+// and closed, and a new configuration — and it must be reused exactly when
+// nothing changed.
 TEST(TreeSolver, AReusedFactorIsBitForBitAFreshOne) {
   std::mt19937 rng(41);
   SolverOptions opt;
@@ -561,6 +563,7 @@ TEST(TreeSolver, AReusedFactorIsBitForBitAFreshOne) {
         Ka.row(0) = randomRow(rng).transpose();
         Kb.row(0) = randomRow(rng).transpose();
         s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
+        s.joint.push_back(std::make_shared<JointRows>("gear", MatX::Random(1, s.model.nv)));
       }
       if (!floating)  // a row on the one velocity of a revolute joint: it locks that joint
         s.joint.push_back(std::make_shared<JointRows>("lock", MatX::Constant(1, 1, 2.0),

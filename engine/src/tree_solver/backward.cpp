@@ -388,19 +388,39 @@ void factorPassIfChanged(const Model& model, const Data& data, const ConstraintD
       rec.next[n++] = active ? 1.0 : 0.0;
       rec.next[n++] = active ? cdata.blocks[jr.constraint].A_joint(jr.row, 0) : 0.0;
     }
-  const bool same = rec.valid && n == rec.length && rec.q == q &&
-                    std::equal(rec.next.begin(), rec.next.begin() + n, rec.rows.begin());
-  ws.last_factor_reused = same;
-  if (same) {
-    ws.redundant = rec.redundant;  // what factorPass set; the callers add to it
-    return;
+  const int tree_length = n;
+  const int capacity = static_cast<int>(rec.next.size());
+  bool fits = true;  // a joint-space row's columns are sized by its ConstraintData
+  for (const LoopRow& lr : ws.loops) {
+    const RowBlock& blk = cdata.blocks[lr.constraint];
+    if (lr.joint_space) {
+      const int cols = static_cast<int>(blk.joint_cols.size());
+      fits = fits && n + 1 + cols <= capacity;
+      if (!fits) break;
+      rec.next[n++] = cols;
+      for (int c = 0; c < cols; ++c) rec.next[n++] = blk.A_joint(lr.row, c);
+    } else {
+      for (int c = 0; c < 6; ++c) rec.next[n++] = blk.Wa(lr.row, c);
+      for (int c = 0; c < 6; ++c) rec.next[n++] = blk.Wb(lr.row, c);
+    }
   }
-  factorPass(model, data, cdata, ws);
+  auto equal = [&](int from, int to) {
+    return std::equal(rec.next.begin() + from, rec.next.begin() + to, rec.rows.begin() + from);
+  };
+  const bool tree_same = rec.valid && tree_length == rec.tree_length && rec.q == q &&
+                         equal(0, tree_length);
+  const bool loops_same = tree_same && fits && n == rec.length && equal(tree_length, n);
+  ws.last_factor_reused = tree_same;
+  if (!loops_same) ws.loop_closure_valid = false;
+  if (!tree_same) factorPass(model, data, cdata, ws);
+  else ws.redundant = rec.redundant;  // what factorPass set; the callers add to it
+  if (loops_same) return;
   std::swap(rec.rows, rec.next);  // same capacity: no allocation
+  rec.tree_length = tree_length;
   rec.length = n;
   rec.q = q;
   rec.redundant = ws.redundant;
-  rec.valid = true;
+  rec.valid = fits;
 }
 
 void velocityCouplings(const Model& model, TreeWorkspace& ws) {

@@ -71,42 +71,13 @@ double freeShare(const Model& model, const Data& data, const ConstraintData& cda
   return f2 > 0 ? std::sqrt(mv2 / f2) : 0.0;
 }
 
-}  // namespace
-
-void loopTargets(const Model& model, const Data& data, const ConstraintData& cdata,
-                 TreeWorkspace& ws, const VecX& v, bool impulse) {
-  for (size_t l = 0; l < ws.loops.size(); ++l) {
-    const LoopRow& lr = ws.loops[l];
-    const RowBlock& blk = cdata.blocks[lr.constraint];
-    double t;
-    if (lr.joint_space) {
-      t = impulse ? -(jointRowDot(blk, lr.row, v) + blk.b_joint[lr.row])
-                  : -blk.abias_joint[lr.row];
-    } else if (impulse) {
-      const Vec6 VA = data.oMi[lr.bodyA].act(data.v[lr.bodyA]);
-      const Vec6 VB = data.oMi[lr.bodyB].act(data.v[lr.bodyB]);
-      t = -(blk.Wa.row(lr.row).dot(VA) - blk.Wb.row(lr.row).dot(VB) + blk.b[lr.row]);
-    } else {
-      // On gravity-shifted accelerations a' = a − g (both bodies see the same g).
-      t = -blk.kappa[lr.row] -
-          (blk.Wa.row(lr.row).tail<3>() - blk.Wb.row(lr.row).tail<3>()).dot(model.gravity);
-    }
-    ws.loop_target[l] = t;
-  }
-}
-
-bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdata,
-                TreeWorkspace& ws) {
+/// The loop closure's part that depends on the factor and the loop rows
+/// only: each loop row's unit response (W, L, Z), Z equilibrated, and Z's
+/// SVD with its rank. Kept while the factor record holds (FactorRecord).
+void formLoopClosure(const Model& model, const Data& data, const ConstraintData& cdata,
+                     TreeWorkspace& ws) {
   const int k = static_cast<int>(ws.loops.size());
-  if (k == 0) return true;
   const SolverOptions& o = ws.options;
-
-  // Main pass: keep it, and the loop rows' residuals on it.
-  ws.vdot0 = ws.vdot;
-  ws.lambda0 = ws.lambda;
-  for (int i = 0; i < model.nbodies; ++i) ws.a0[i] = ws.nodes[i].a;
-  for (int l = 0; l < k; ++l) ws.loop_rhs[l] = ws.loop_target[l] - applyRow(cdata, data, ws, ws.loops[l]);
-
   // Unit solves: the response to each loop row's generalized force B_lᵀ,
   // with no velocity terms, no gravity and homogeneous tree rows — so the
   // body accelerations are J_i v̇ and Z's column is their M-metric root.
@@ -154,17 +125,63 @@ bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdat
     ws.loop_scale[l] = mobile ? 1.0 / d : ws.loop_fnorm[l] > 0 ? 1.0 / ws.loop_fnorm[l] : 1.0;
     ws.Z.col(l) *= mobile ? ws.loop_scale[l] : 0.0;
   }
-  ws.loop_res = ws.loop_scale.cwiseProduct(ws.loop_rhs);
-
   // Z = U Σ Vᵀ, so S = V Σ² Vᵀ: λ = V₁ Σ₁⁻² V₁ᵀ r, and the part of r along V₂
   // (directions no loop force moves) is the inconsistency.
   ws.z_svd.compute(ws.Z, Eigen::ComputeThinV);
   const auto& s = ws.z_svd.singularValues();
-  const auto& V = ws.z_svd.matrixV();
   const double thr = std::max(o.rank_abs_tol, o.rank_rel_tol * s(0));  // s(0) ≤ √k
   int rank = 0;
   while (rank < k && s(rank) > thr) ++rank;
   ws.loop_rank = rank;
+}
+
+}  // namespace
+
+void loopTargets(const Model& model, const Data& data, const ConstraintData& cdata,
+                 TreeWorkspace& ws, const VecX& v, bool impulse) {
+  for (size_t l = 0; l < ws.loops.size(); ++l) {
+    const LoopRow& lr = ws.loops[l];
+    const RowBlock& blk = cdata.blocks[lr.constraint];
+    double t;
+    if (lr.joint_space) {
+      t = impulse ? -(jointRowDot(blk, lr.row, v) + blk.b_joint[lr.row])
+                  : -blk.abias_joint[lr.row];
+    } else if (impulse) {
+      const Vec6 VA = data.oMi[lr.bodyA].act(data.v[lr.bodyA]);
+      const Vec6 VB = data.oMi[lr.bodyB].act(data.v[lr.bodyB]);
+      t = -(blk.Wa.row(lr.row).dot(VA) - blk.Wb.row(lr.row).dot(VB) + blk.b[lr.row]);
+    } else {
+      // On gravity-shifted accelerations a' = a − g (both bodies see the same g).
+      t = -blk.kappa[lr.row] -
+          (blk.Wa.row(lr.row).tail<3>() - blk.Wb.row(lr.row).tail<3>()).dot(model.gravity);
+    }
+    ws.loop_target[l] = t;
+  }
+}
+
+bool solveLoops(const Model& model, const Data& data, const ConstraintData& cdata,
+                TreeWorkspace& ws) {
+  const int k = static_cast<int>(ws.loops.size());
+  if (k == 0) return true;
+  const SolverOptions& o = ws.options;
+
+  // Main pass: keep it, and the loop rows' residuals on it.
+  ws.vdot0 = ws.vdot;
+  ws.lambda0 = ws.lambda;
+  for (int i = 0; i < model.nbodies; ++i) ws.a0[i] = ws.nodes[i].a;
+  for (int l = 0; l < k; ++l) ws.loop_rhs[l] = ws.loop_target[l] - applyRow(cdata, data, ws, ws.loops[l]);
+
+  if (!ws.loop_closure_valid) {
+    formLoopClosure(model, data, cdata, ws);
+    ws.loop_closure_valid = true;
+  }
+  ws.loop_res = ws.loop_scale.cwiseProduct(ws.loop_rhs);
+
+  // Z = U Σ Vᵀ (formLoopClosure), so S = V Σ² Vᵀ: λ = V₁ Σ₁⁻² V₁ᵀ r, and
+  // the part of r along V₂ (directions no loop force moves) is the inconsistency.
+  const auto& s = ws.z_svd.singularValues();
+  const auto& V = ws.z_svd.matrixV();
+  const int rank = ws.loop_rank;
   ws.loop_tmp.noalias() = V.transpose() * ws.loop_res;
   ws.loop_tmp.head(rank).array() /= s.head(rank).array().square();
   ws.loop_lambda.noalias() = V.leftCols(rank) * ws.loop_tmp.head(rank);

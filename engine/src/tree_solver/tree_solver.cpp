@@ -84,6 +84,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
     int length = 0;
     for (const auto& tb : ws.blocks) length += 1 + 6 * tb.declared;
     for (int b : ws.jrow_nodes) length += 2 * static_cast<int>(ws.nodes[b].jrows.size());
+    for (const auto& lr : ws.loops) length += lr.joint_space ? 1 + model.nv : 12;
     ws.factor_record.rows.assign(length, 0.0);
     ws.factor_record.next.assign(length, 0.0);
     ws.factor_record.q = VecX::Zero(model.nq);
@@ -154,7 +155,10 @@ int TreeSolver::loopRows() const { return static_cast<int>(ws_->loops.size()); }
 int TreeSolver::redundantRows() const { return ws_->last_redundant; }
 bool TreeSolver::lastSolveClosedForm() const { return ws_->last_closed_form; }
 bool TreeSolver::lastFactorReused() const { return ws_->last_factor_reused; }
-void TreeSolver::forgetFactor() { ws_->factor_record.valid = false; }
+void TreeSolver::forgetFactor() {
+  ws_->factor_record.valid = false;
+  ws_->loop_closure_valid = false;
+}
 const std::string& TreeSolver::lastError() const { return ws_->last_error; }
 
 namespace {

@@ -267,13 +267,16 @@ struct Failure {
 /// What the passes' factor (factorPass) was formed from, by value: the
 /// configuration (the kinematics are forwardKinematics(q)'s) and, after the
 /// active set, each block's row count and covectors and each joint row's
-/// state. The model is the one the solver was built for (immutable, as for
-/// the constructor's own precomputations). Sized by the constructor.
+/// state — then the loop rows' coefficients, on which the loop closure's
+/// unit responses and their SVD depend as well. The model is the one the
+/// solver was built for (immutable, as for the constructor's own
+/// precomputations). Sized by the constructor.
 struct FactorRecord {
   bool valid = false;
   VecX q;
   std::vector<double> rows, next;  ///< the record, and this call's (swapped in)
-  int length = 0;
+  int tree_length = 0;             ///< entries of the tree part (factorPass's inputs)
+  int length = 0;                  ///< with the loop rows
   int redundant = 0;               ///< factorPass's redundancy count
 };
 
@@ -292,6 +295,7 @@ struct TreeWorkspace {
   double free_body_lambda_min = 0;        ///< λ_min(I) = σ_min(L)²
   FactorRecord factor_record;             ///< factorPassIfChanged
   bool last_factor_reused = false;        ///< the last solve / projection skipped factorPass
+  bool loop_closure_valid = false;        ///< W, L, Z and its SVD are for the recorded rows (loops.cpp)
 
   // Solver scratch with compile-time maximum sizes.
   Eigen::JacobiSVD<SmallMat, Eigen::ColPivHouseholderQRPreconditioner> svd;
