@@ -229,6 +229,29 @@ TEST(CoreKinematics, ConfigurationRateMatchesRetractAndKinematics) {
   }
 }
 
+// An RKMK stage takes q = retract(q₀, θ) and θ̇ = localRate(q₀, θ, v) in one
+// call (retractWithRate: one half-angle sine and cosine per rotation). It
+// must be the two separate maps to round-off, for every joint type, at
+// rotations of up to ~2 rad and below the series thresholds (1e-3, 1e-4).
+TEST(CoreKinematics, RetractWithRateIsRetractAndLocalRate) {
+  std::mt19937 rng(5);
+  for (const Model& model : models()) {
+    for (double scale : {1.2, 5e-4, 5e-5, 0.0}) {
+      const VecX q0 = randomConfiguration(model, rng);
+      const VecX theta = test::randomVector(model.nv, rng, scale);
+      const VecX v = test::randomVector(model.nv, rng, 2.0);
+      VecX q1(model.nq), q2(model.nq), r1(model.nv), r2(model.nv);
+      retract(model, q0, theta, q1);
+      localRate(model, q0, theta, v, r1);
+      retractWithRate(model, q0, theta, v, q2, r2);
+      EXPECT_LT((q1 - q2).lpNorm<Eigen::Infinity>(), 4e-16 * (1 + q1.lpNorm<Eigen::Infinity>()))
+          << "scale " << scale;
+      EXPECT_LT((r1 - r2).lpNorm<Eigen::Infinity>(), 1e-15 * (1 + r1.lpNorm<Eigen::Infinity>()))
+          << "scale " << scale;
+    }
+  }
+}
+
 // Quaternions are advanced by exact rotations (q ⊗ exp(θ)), so they stay unit
 // to round-off however long the run: the deviation grows like a random walk of
 // the rounding error (√N ε_mach), not with the step size.

@@ -20,6 +20,12 @@ VecX neutralConfiguration(const Model& model);
 /// q = retract(q0, θ): move from q0 by the local coordinates θ (size nv).
 void retract(const Model& model, const VecX& q0, const VecX& theta, VecX& q);
 
+/// retract(q0, θ) into q and localRate(q0, θ, v) into θ̇ together, as an
+/// RKMK stage needs them: each rotation's exponential and dexp⁻¹ share one
+/// half-angle sine and cosine (three fewer transcendental calls per joint).
+void retractWithRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
+                     VecX& q, VecX& theta_dot);
+
 /// θ̇ = T(q0, θ) v: rate of the local coordinates for velocity v at q = retract(q0, θ).
 void localRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
                VecX& theta_dot);

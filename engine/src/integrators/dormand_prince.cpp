@@ -59,8 +59,7 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
         theta_ += (h * A[s][k]) * kth_[k];
         vs_ += (h * A[s][k]) * kv_[k];
       }
-      retract(model_, q, theta_, qs_);
-      localRate(model_, q, theta_, vs_, kth_[s]);
+      retractWithRate(model_, q, theta_, vs_, qs_, kth_[s]);
       ++r.evaluations;
       field_ok = f(t + C[s] * h, qs_, vs_, kv_[s]) && kv_[s].allFinite() && qs_.allFinite();
       if (field_ok) readRates(f, rates_[s]);

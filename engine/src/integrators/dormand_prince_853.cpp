@@ -76,8 +76,7 @@ void DormandPrince853::stageState(int s, double h, const VecX& q, const VecX& v)
     theta_ += (h * dop853::A[s][k]) * kth_[k];
     vs_ += (h * dop853::A[s][k]) * kv_[k];
   }
-  retract(model_, q, theta_, qs_);
-  localRate(model_, q, theta_, vs_, kth_[s]);
+  retractWithRate(model_, q, theta_, vs_, qs_, kth_[s]);
 }
 
 StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) {

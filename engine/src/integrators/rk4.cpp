@@ -20,12 +20,12 @@ StepResult RungeKutta4::step(AccelerationField& f, double& t, VecX& q, VecX& v, 
       theta_.setZero();
       vs_ = v;
       qs_ = q;
+      localRate(model_, q, theta_, vs_, kth_[s]);
     } else {
       theta_ = (c[s] * h) * kth_[s - 1];
       vs_ = v + (c[s] * h) * kv_[s - 1];
-      retract(model_, q, theta_, qs_);
+      retractWithRate(model_, q, theta_, vs_, qs_, kth_[s]);
     }
-    localRate(model_, q, theta_, vs_, kth_[s]);
     ++r.evaluations;
     if (!f(t + c[s] * h, qs_, vs_, kv_[s]) || !kv_[s].allFinite()) {
       r.ok = false;

@@ -27,20 +27,95 @@ VecX neutralConfiguration(const Model& model) {
 //   Euclidean coordinates      θ = q − q₀              (planar: Δa, Δb, Δφ)
 //   floating  θ = (θ_R, Δp)    R = R₀ exp(θ_R), p = p₀ + Δp (world)
 //   ball      θ = θ_R
+namespace {
+
+/// One joint of retract (q = q0 beforehand).
+void retractJoint(const Joint& j, const VecX& q0, const VecX& theta, VecX& q) {
+  switch (j.type) {
+    case JointType::Fixed: break;
+    case JointType::Floating:
+      q.segment<3>(j.idx_q) += theta.segment<3>(j.idx_v + 3);
+      setQuat(q, j.idx_q + 3, quatAt(q0, j.idx_q + 3) * quatExp(theta.segment<3>(j.idx_v)));
+      break;
+    case JointType::Ball:
+      setQuat(q, j.idx_q, quatAt(q0, j.idx_q) * quatExp(theta.segment<3>(j.idx_v)));
+      break;
+    default:
+      q.segment(j.idx_q, j.nq) += theta.segment(j.idx_v, j.nv);
+  }
+}
+
+/// One joint of localRate.
+void jointRate(const Joint& j, const VecX& q0, const VecX& theta, const VecX& v,
+               VecX& theta_dot) {
+  const int iv = j.idx_v;
+  switch (j.type) {
+    case JointType::Fixed: break;
+    case JointType::Floating: {
+      const Vec3 th = theta.segment<3>(iv);
+      const Quat r = quatAt(q0, j.idx_q + 3) * quatExp(th);
+      theta_dot.segment<3>(iv) = dexpInv(th) * v.segment<3>(iv);
+      theta_dot.segment<3>(iv + 3) = r * Vec3(v.segment<3>(iv + 3));
+      break;
+    }
+    case JointType::Ball:
+      theta_dot.segment<3>(iv) = dexpInv(theta.segment<3>(iv)) * v.segment<3>(iv);
+      break;
+    case JointType::Planar: {
+      const double phi = q0[j.idx_q + 2] + theta[iv + 2];
+      const double c = std::cos(phi), s = std::sin(phi);
+      theta_dot[iv] = c * v[iv] - s * v[iv + 1];
+      theta_dot[iv + 1] = s * v[iv] + c * v[iv + 1];
+      theta_dot[iv + 2] = v[iv + 2];
+      break;
+    }
+    default:
+      theta_dot[iv] = v[iv];
+  }
+}
+
+}  // namespace
+
 void retract(const Model& model, const VecX& q0, const VecX& theta, VecX& q) {
   q = q0;
+  for (const Joint& j : model.joints) retractJoint(j, q0, theta, q);
+}
+
+namespace {
+
+/// exp(θ̂) as a quaternion and dexp⁻¹(θ) ω from one sine and cosine of |θ|/2
+/// (quatExp and dexpInv in spatial.hpp, with their series at small angles):
+/// dexp⁻¹(θ) ω = ω + ½ θ × ω + c θ × (θ × ω),  c = (1 − (t/2) cot(t/2))/t².
+Quat expWithRate(const Vec3& th, const Vec3& w, Vec3& th_dot) {
+  const double t = th.norm(), half = 0.5 * t;
+  const double s = std::sin(half), co = std::cos(half);
+  const double k = t < 1e-4 ? 0.5 - t * t / 48.0 : s / t;
+  const double c = t < 1e-3 ? 1.0 / 12.0 + t * t / 720.0 : (1.0 - half * co / s) / (t * t);
+  const Vec3 txw = th.cross(w);
+  th_dot = w + 0.5 * txw + c * th.cross(txw);
+  return Quat(co, k * th.x(), k * th.y(), k * th.z());
+}
+
+}  // namespace
+
+void retractWithRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
+                     VecX& q, VecX& theta_dot) {
+  q = q0;
   for (const Joint& j : model.joints) {
-    switch (j.type) {
-      case JointType::Fixed: break;
-      case JointType::Floating:
-        q.segment<3>(j.idx_q) += theta.segment<3>(j.idx_v + 3);
-        setQuat(q, j.idx_q + 3, quatAt(q0, j.idx_q + 3) * quatExp(theta.segment<3>(j.idx_v)));
-        break;
-      case JointType::Ball:
-        setQuat(q, j.idx_q, quatAt(q0, j.idx_q) * quatExp(theta.segment<3>(j.idx_v)));
-        break;
-      default:
-        q.segment(j.idx_q, j.nq) += theta.segment(j.idx_v, j.nv);
+    const int iv = j.idx_v;
+    Vec3 w_dot;
+    if (j.type == JointType::Floating) {
+      const Quat r = quatAt(q0, j.idx_q + 3) * expWithRate(theta.segment<3>(iv), v.segment<3>(iv), w_dot);
+      q.segment<3>(j.idx_q) += theta.segment<3>(iv + 3);
+      setQuat(q, j.idx_q + 3, r);
+      theta_dot.segment<3>(iv) = w_dot;
+      theta_dot.segment<3>(iv + 3) = r * Vec3(v.segment<3>(iv + 3));
+    } else if (j.type == JointType::Ball) {
+      setQuat(q, j.idx_q, quatAt(q0, j.idx_q) * expWithRate(theta.segment<3>(iv), v.segment<3>(iv), w_dot));
+      theta_dot.segment<3>(iv) = w_dot;
+    } else {
+      retractJoint(j, q0, theta, q);
+      jointRate(j, q0, theta, v, theta_dot);
     }
   }
 }
@@ -96,32 +171,7 @@ void integrate(const Model& model, const VecX& q0, const VecX& v, double h, VecX
 
 void localRate(const Model& model, const VecX& q0, const VecX& theta, const VecX& v,
                VecX& theta_dot) {
-  for (const Joint& j : model.joints) {
-    const int iv = j.idx_v;
-    switch (j.type) {
-      case JointType::Fixed: break;
-      case JointType::Floating: {
-        const Vec3 th = theta.segment<3>(iv);
-        const Quat r = quatAt(q0, j.idx_q + 3) * quatExp(th);
-        theta_dot.segment<3>(iv) = dexpInv(th) * v.segment<3>(iv);
-        theta_dot.segment<3>(iv + 3) = r * Vec3(v.segment<3>(iv + 3));
-        break;
-      }
-      case JointType::Ball:
-        theta_dot.segment<3>(iv) = dexpInv(theta.segment<3>(iv)) * v.segment<3>(iv);
-        break;
-      case JointType::Planar: {
-        const double phi = q0[j.idx_q + 2] + theta[iv + 2];
-        const double c = std::cos(phi), s = std::sin(phi);
-        theta_dot[iv] = c * v[iv] - s * v[iv + 1];
-        theta_dot[iv + 1] = s * v[iv] + c * v[iv + 1];
-        theta_dot[iv + 2] = v[iv + 2];
-        break;
-      }
-      default:
-        theta_dot[iv] = v[iv];
-    }
-  }
+  for (const Joint& j : model.joints) jointRate(j, q0, theta, v, theta_dot);
 }
 
 void difference(const Model& model, const VecX& q0, const VecX& q1, VecX& theta) {
