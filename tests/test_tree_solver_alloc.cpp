@@ -3,7 +3,8 @@
 // counted (operator new and malloc & co., which Eigen uses), and the count
 // over repeated solves must be zero — on random trees with redundant rows,
 // with loop rows (also redundant ones), and with rows handed up with their
-// compliance — the minimum-norm step included.
+// compliance — the minimum-norm step included, with the factor formed anew
+// and reused.
 #include "tree_solver_common.hpp"
 
 #include <gtest/gtest.h>
@@ -35,6 +36,17 @@ void expectNoAllocation(System& s) {
               solver.projectVelocity(s.model, data, list, cd, s.q, v, mu);
             }),
             0);
+  // The projection above reused the solve's factor; now each path the other way
+  // round: a solve that reuses it, a projection that forms it anew.
+  EXPECT_EQ(allocationsIn([&] { solver.solve(s.model, data, list, cd, s.q, s.v, s.tau, out); }), 0);
+  EXPECT_TRUE(solver.lastFactorReused() || solver.lastSolveClosedForm());
+  solver.forgetFactor();
+  EXPECT_EQ(allocationsIn([&] {
+              v = s.v;
+              solver.projectVelocity(s.model, data, list, cd, s.q, v, mu);
+            }),
+            0);
+  EXPECT_FALSE(solver.lastFactorReused());
 }
 
 }  // namespace
