@@ -107,6 +107,7 @@ TEST_P(Allocations, DynamicsDoNotAllocate) {
 TEST_P(Allocations, ConfigurationManifoldDoesNotAllocate) {
   EXPECT_EQ(allocationsIn([&] { retract(model, q, theta, out_q); }), 0);
   EXPECT_EQ(allocationsIn([&] { localRate(model, q, theta, v, out_v); }), 0);
+  EXPECT_EQ(allocationsIn([&] { retractWithRate(model, q, theta, v, out_q, out_v); }), 0);
   EXPECT_EQ(allocationsIn([&] { difference(model, q, out_q, out_v); }), 0);
   EXPECT_EQ(allocationsIn([&] { configurationRate(model, q, v, out_q); }), 0);
 }
