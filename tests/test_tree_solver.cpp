@@ -622,3 +622,47 @@ TEST(TreeSolver, AReusedFactorIsBitForBitAFreshOne) {
   }
   EXPECT_EQ(reused, 6);
 }
+
+// An integrator stage asks for v̇ only, and the forward pass then skips the
+// multipliers — v̇ never reads them, except below a body that hands rows up
+// with their compliance (softForward reads the multipliers its parent
+// unrolls), where they are kept. Either way v̇ must be bit for bit the full
+// solve's: on random trees with redundant and immobile rows, loop rows, a
+// locked joint, and rows their joints barely move (compliance).
+TEST(TreeSolver, AccelerationsAloneAreTheFullSolvesBitForBit) {
+  std::mt19937 rng(43);
+  int soft = 0;
+  for (int n : {3, 9, 20}) {
+    for (bool floating : {false, true}) {
+      for (double sigma : {0.0, 1e-3}) {
+        System s = randomSystem(n, floating, rng, RowRecipe{0.2, 0.2, 1});
+        if (sigma > 0) addWeakRows(s, 3, sigma, rng), ++soft;
+        std::uniform_int_distribution<int> body(0, n - 1);
+        Rows Ka(1, 6), Kb(1, 6);
+        Ka.row(0) = randomRow(rng).transpose();
+        Kb.row(0) = randomRow(rng).transpose();
+        s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
+        if (!floating)
+          s.joint.push_back(std::make_shared<JointRows>("lock", MatX::Constant(1, 1, 2.0),
+                                                        std::vector<int>{s.model.nv - 1}));
+        makeConsistent(s, rng);
+        const ConstraintList list = s.list();
+        Data data(s.model);
+        ConstraintData cd(s.model, list);
+        evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+        TreeSolver a(s.model, list), b(s.model, list);
+        ConstrainedResult all, acc;
+        a.solve(s.model, data, list, cd, s.q, s.v, s.tau, all, SolveOutputs::All);
+        b.solve(s.model, data, list, cd, s.q, s.v, s.tau, acc, SolveOutputs::Accelerations);
+        ASSERT_TRUE(all.ok && acc.ok) << all.error << acc.error;
+        EXPECT_TRUE(all.vdot == acc.vdot) << "n=" << n << " sigma=" << sigma;
+        // And the factor the v̇-only solve left serves a full solve after it.
+        ConstrainedResult again;
+        b.solve(s.model, data, list, cd, s.q, s.v, s.tau, again, SolveOutputs::All);
+        EXPECT_TRUE(b.lastFactorReused());
+        EXPECT_TRUE(again.vdot == all.vdot && again.lambda == all.lambda) << "n=" << n;
+      }
+    }
+  }
+  EXPECT_EQ(soft, 6);
+}

@@ -283,6 +283,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
   for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].IA = model.spatial_inertia[i];
   ws.redundant = 0;
   ws.nseeds = 0;
+  ws.any_soft = false;
 
   for (int i = model.nbodies - 1; i >= 0; --i) {
     Node& nd = ws.nodes[i];
@@ -368,6 +369,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       ws.seeds[ws.nseeds++] = i;
     }
     if (p >= 0) addCongruence(data.liMi[i], H, ws.nodes[p].IA);
+    ws.any_soft = ws.any_soft || nd.soft;
   }
 }
 

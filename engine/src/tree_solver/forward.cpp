@@ -49,13 +49,14 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
         }
       }
       ws.vdot[j.idx_v] = nd.rho;
+      if (!ws.multipliers) continue;
       lockedForce(j, nd, ws.tau[j.idx_v], ws.lambda);
       if (nd.ncomp > 0) unrollNode(ws, i, nd.ncomp - 1, ws.lambda);
       continue;
     }
     if (nd.soft) {
       softForward(j, nd, abar, ws.vdot);
-      unrollNode(ws, i, nd.ncomp - 1, ws.lambda);
+      if (ws.multipliers) unrollNode(ws, i, nd.ncomp - 1, ws.lambda);
       continue;
     }
 
@@ -101,8 +102,9 @@ bool forwardPass(const Model& model, const Data& data, TreeWorkspace& ws, bool c
 
     // Multipliers of K from the joint's force balance  Gᵀ μ = Sᵀ f − τ with
     // f = IA a + pA (the force the joint transmits, constraint forces of
-    // this body's rows excluded); the U₂ part comes from the parent.
-    if (nd.ncomp > 0) {
+    // this body's rows excluded); the U₂ part comes from the parent. The
+    // accelerations above never read them: skipped when only v̇ is asked for.
+    if (nd.ncomp > 0 && ws.multipliers) {
       KVec& mu = nd.comp[nd.ncomp - 1].mu;
       mu.setZero(nd.nK);
       if (nd.rankG > 0 && j.nv == 1) {

@@ -81,9 +81,10 @@ void formLoopClosure(const Model& model, const Data& data, const ConstraintData&
   // Unit solves: the response to each loop row's generalized force B_lᵀ,
   // with no velocity terms, no gravity and homogeneous tree rows — so the
   // body accelerations are J_i v̇ and Z's column is their M-metric root.
-  const bool use_c = ws.use_c;
+  const bool use_c = ws.use_c, multipliers = ws.multipliers;
   const Vec6 a_world = ws.a_world;
   ws.use_c = false;
+  ws.multipliers = true;  // L, the responses' multipliers, is kept with the closure
   ws.a_world.setZero();
   for (auto& nd : ws.nodes) nd.bias0.setZero();
   for (auto& tb : ws.blocks) tb.rhs.setZero();
@@ -113,6 +114,7 @@ void formLoopClosure(const Model& model, const Data& data, const ConstraintData&
     }
   }
   ws.use_c = use_c;
+  ws.multipliers = multipliers;
   ws.a_world = a_world;
 
   // Equilibrate the columns (S's diagonal to 1). A row whose force the tree

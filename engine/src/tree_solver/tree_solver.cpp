@@ -263,6 +263,7 @@ void TreeSolver::solve(const Model& model, Data& data, const ConstraintList& con
   detail::factorPassIfChanged(model, data, cdata, q, ws);
   detail::velocityCouplings(model, ws);
   ws.use_c = true;
+  ws.multipliers = outputs != SolveOutputs::Accelerations || ws.any_soft;
   ws.lambda.setZero();
   detail::loopTargets(model, data, cdata, ws, v, false);
   if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||
@@ -313,6 +314,7 @@ bool TreeSolver::projectVelocity(const Model& model, Data& data, const Constrain
     detail::factorPassIfChanged(model, data, cdata, q, ws);
     for (auto& nd : ws.nodes) nd.bias0.setZero();
     ws.use_c = false;
+    ws.multipliers = true;  // μ is the impulse
     ws.lambda.setZero();
     detail::loopTargets(model, data, cdata, ws, v, true);
     if (!detail::biasPass(model, data, ws, true) || !detail::forwardPass(model, data, ws, true) ||

@@ -304,6 +304,12 @@ struct TreeWorkspace {
   VecX tau;                               ///< generalized force of the pass
   Vec6 a_world;                           ///< world acceleration (world frame)
   bool use_c = true;
+  /// The forward pass unrolls the multipliers (ws.lambda). An integrator
+  /// stage asks for v̇ only, which does not depend on them (forward.cpp) —
+  /// unless a body hands rows up with their compliance: its accelerations
+  /// read the multipliers its parent unrolls (soft.cpp, softForward).
+  bool multipliers = true;
+  bool any_soft = false;                  ///< a body of the factor is soft (factorPass)
 
   // Outputs of one pass.
   VecX vdot, lambda;
