@@ -534,6 +534,28 @@ TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
   EXPECT_GT(fallback, 20);
 }
 
+namespace {
+
+// A loop row between two random bodies and, with `gear`, a joint-space row
+// over every velocity (both closed by the loop closure, loops.cpp).
+void addLoopRows(System& s, std::mt19937& rng, bool gear) {
+  std::uniform_int_distribution<int> body(0, s.model.nbodies - 1);
+  Rows Ka(1, 6), Kb(1, 6);
+  Ka.row(0) = randomRow(rng).transpose();
+  Kb.row(0) = randomRow(rng).transpose();
+  s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
+  if (gear) s.joint.push_back(std::make_shared<JointRows>("gear", MatX::Random(1, s.model.nv)));
+}
+
+// A row on the last velocity alone — a revolute joint's on a fixed base: it
+// locks that joint (locked.cpp).
+void addLockRow(System& s) {
+  s.joint.push_back(std::make_shared<JointRows>("lock", MatX::Constant(1, 1, 2.0),
+                                                std::vector<int>{s.model.nv - 1}));
+}
+
+}  // namespace
+
 // The factor of the backward pass depends on the configuration and the rows
 // only, so a solve or projection at the same ones reuses it
 // (FactorRecord): an integrator stage's factor serves the projection after
@@ -558,16 +580,8 @@ TEST(TreeSolver, AReusedFactorIsBitForBitAFreshOne) {
         K.row(1) = randomRow(rng).transpose();
         s.local.insert(s.local.begin(), std::make_shared<LocalRows>("own", body(rng), K));
       }
-      if (n > 1) {
-        Rows Ka(1, 6), Kb(1, 6);
-        Ka.row(0) = randomRow(rng).transpose();
-        Kb.row(0) = randomRow(rng).transpose();
-        s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
-        s.joint.push_back(std::make_shared<JointRows>("gear", MatX::Random(1, s.model.nv)));
-      }
-      if (!floating)  // a row on the one velocity of a revolute joint: it locks that joint
-        s.joint.push_back(std::make_shared<JointRows>("lock", MatX::Constant(1, 1, 2.0),
-                                                      std::vector<int>{s.model.nv - 1}));
+      if (n > 1) addLoopRows(s, rng, /*gear=*/true);
+      if (!floating) addLockRow(s);
       makeConsistent(s, rng);
       const ConstraintList list = s.list();
       Data data(s.model);
@@ -637,14 +651,8 @@ TEST(TreeSolver, AccelerationsAloneAreTheFullSolvesBitForBit) {
       for (double sigma : {0.0, 1e-3}) {
         System s = randomSystem(n, floating, rng, RowRecipe{0.2, 0.2, 1});
         if (sigma > 0) addWeakRows(s, 3, sigma, rng), ++soft;
-        std::uniform_int_distribution<int> body(0, n - 1);
-        Rows Ka(1, 6), Kb(1, 6);
-        Ka.row(0) = randomRow(rng).transpose();
-        Kb.row(0) = randomRow(rng).transpose();
-        s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
-        if (!floating)
-          s.joint.push_back(std::make_shared<JointRows>("lock", MatX::Constant(1, 1, 2.0),
-                                                        std::vector<int>{s.model.nv - 1}));
+        addLoopRows(s, rng, /*gear=*/false);
+        if (!floating) addLockRow(s);
         makeConsistent(s, rng);
         const ConstraintList list = s.list();
         Data data(s.model);
