@@ -92,11 +92,7 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
       // FSAL: the last stage is the next step's first. Swapped, not copied:
       // kv_[6] keeps this step's k₁ for the dense output (kv_[0] is its k₇).
       // The rates by the same 5th-order weights (row 7 of A; b₇ = 0).
-      for (int i = 0; i < AccelerationField::kMaxRates; ++i) {
-        double sum = 0;
-        for (int k = 0; k < 6; ++k) sum += A[6][k] * rates_[k][i];
-        r.integrals[i] = h * sum;
-      }
+      integrateRates(h, A[6], 6, rates_, r);
       std::swap(kv_[0], kv_[6]);
       std::swap(rates_[0], rates_[6]);
       have_fsal_ = true;

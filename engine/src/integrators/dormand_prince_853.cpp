@@ -145,11 +145,7 @@ StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX
       q = q1_;
       v = v1_;
       t += h;
-      for (int i = 0; i < AccelerationField::kMaxRates; ++i) {
-        double sum = 0;
-        for (int k = 0; k < dop853::kStages; ++k) sum += dop853::A[dop853::kStages][k] * rates_[k][i];
-        r.integrals[i] = h * sum;
-      }
+      integrateRates(h, dop853::A[dop853::kStages], dop853::kStages, rates_, r);
       have_fsal_ = true;
       fsal_pending_ = true;  // kv_[12] becomes the next k₁ once the dense output is done with it
       r.h_taken = h;

@@ -20,6 +20,18 @@ inline void readRates(const AccelerationField& f, StageRates& out) {
   for (int i = 0; i < AccelerationField::kMaxRates; ++i) out[i] = i < n ? f.rate(i) : 0.0;
 }
 
+/// The step's work integrals, h Σₖ bₖ ρₖ over its first `stages` stages: the
+/// rates ρ (powers) integrated with the weights b that advance the state.
+template <size_t N>
+void integrateRates(double h, const double* b, int stages, const std::array<StageRates, N>& rates,
+                    StepResult& r) {
+  for (int i = 0; i < AccelerationField::kMaxRates; ++i) {
+    double sum = 0;
+    for (int k = 0; k < stages; ++k) sum += b[k] * rates[k][i];
+    r.integrals[i] = h * sum;
+  }
+}
+
 /// The magnitudes the adaptive methods measure local coordinates against:
 /// the coordinate itself for Euclidean joints, 1 rad for rotations.
 inline void coordinateScales(const Model& model, const VecX& q, VecX& scale) {

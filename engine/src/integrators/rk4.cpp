@@ -44,9 +44,7 @@ StepResult RungeKutta4::step(AccelerationField& f, double& t, VecX& q, VecX& v, 
   v = vs_;
   t += h;
   r.h_taken = r.h_next = h;
-  for (int i = 0; i < AccelerationField::kMaxRates; ++i)
-    r.integrals[i] = h * (w[0] * rates_[0][i] + w[1] * rates_[1][i] + w[2] * rates_[2][i] +
-                          w[3] * rates_[3][i]);
+  integrateRates(h, w, 4, rates_, r);
   return r;
 }
 
