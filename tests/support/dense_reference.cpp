@@ -32,16 +32,25 @@ Reference denseReference(const Model& model, const ConstraintData& cd, const Vec
     return r;
   }
   const ML A = cd.A.cast<long double>();
-  Eigen::JacobiSVD<ML> svd(A * Mih, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  svd.setThreshold(1e-10L);
-  const VL vd = a + Mih * svd.solve(VL(-cd.abias.cast<long double>() - A * a));
+  // Pseudo-inverse solves truncated at σ ≤ max(1e-10 σ₀, 1e-14): the
+  // absolute floor keeps round-off residue (a row the joints cannot move,
+  // ~1e-17) from becoming a constraint, which a purely relative threshold
+  // does when every row is such residue.
+  int rank = 0;
+  auto solve = [&rank](const ML& B, const VL& rhs) {
+    Eigen::JacobiSVD<ML> svd(B, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const auto& sv = svd.singularValues();
+    rank = 0;
+    while (rank < sv.size() && sv(rank) > std::max(1e-10L * sv(0), 1e-14L)) ++rank;
+    const VL y = (svd.matrixU().leftCols(rank).transpose() * rhs).cwiseQuotient(sv.head(rank));
+    return VL(svd.matrixV().leftCols(rank) * y);
+  };
+  const VL vd = a + Mih * solve(A * Mih, VL(-cd.abias.cast<long double>() - A * a));
   const VL reaction = Ml * (vd - a);
-  Eigen::JacobiSVD<ML> svdt(A.transpose(), Eigen::ComputeThinU | Eigen::ComputeThinV);
-  svdt.setThreshold(1e-10L);
   r.vdot = vd.cast<double>();
   r.reaction = reaction.cast<double>();
-  r.lambda = svdt.solve(reaction).cast<double>();
-  r.rank = static_cast<int>(svdt.rank());
+  r.lambda = solve(A.transpose(), reaction).cast<double>();
+  r.rank = rank;
   return r;
 }
 

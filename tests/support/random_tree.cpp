@@ -8,7 +8,10 @@ Inertia randomInertia(std::mt19937& rng) {
   // Principal moments from a random box (always satisfies the triangle inequality).
   const double m = u(rng), a = u(rng), b = u(rng), d = u(rng);
   Vec3 moments(m * (b * b + d * d) / 12, m * (a * a + d * d) / 12, m * (a * a + b * b) / 12);
-  const Mat3 R = Quat::UnitRandom().toRotationMatrix();
+  // From rng, not Quat::UnitRandom() (std::rand): a test's draws must not
+  // depend on which tests ran before it in the same process.
+  std::normal_distribution<double> g;
+  const Mat3 R = Quat(Eigen::Vector4d(g(rng), g(rng), g(rng), g(rng)).normalized()).toRotationMatrix();
   return {m, Vec3(c(rng), c(rng), c(rng)), R * moments.asDiagonal() * R.transpose()};
 }
 
