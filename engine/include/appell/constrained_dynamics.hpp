@@ -43,6 +43,11 @@ struct SolverOptions {
   /// whole, is solved in closed form (tree_solver/free_body.cpp); false runs
   /// the general passes there too (the tests compare the two).
   bool free_body_closed_form = true;
+  /// Tree solver: a body's one stack of rows (one constraint's, or one
+  /// child's handed-up rows) certified independent skips the compression's
+  /// QR (tree_solver/backward.cpp); false factors every stack (the tests
+  /// compare the two).
+  bool certify_independent_stacks = true;
 };
 
 /// What a solve must produce. Integrator stages need only v̇; reports need λ.

@@ -76,6 +76,9 @@ class TreeSolver : public ConstrainedSolver {
   /// projection at an integrator stage's pose, the end-of-step solve after
   /// it). The answer is bit for bit the one a fresh factor gives.
   bool lastFactorReused() const;
+  /// Stacks of the last factor whose rows were certified independent, so
+  /// that no QR compressed them (SolverOptions::certify_independent_stacks).
+  int certifiedStacks() const;
   /// Forgets the recorded factor: the next solve or projection forms it
   /// anew. For benchmarks that time whole solves at one state.
   void forgetFactor();

@@ -8,6 +8,7 @@
 // biasPass: the right sides — articulated bias forces and the right sides of
 // the compressed and handed-up rows; it can be replayed cheaply for the unit
 // solves of the loop closure and for the impulse solve.
+#include "tree_solver/ldlt.hpp"
 #include "tree_solver/workspace.hpp"
 
 #include <algorithm>
@@ -22,22 +23,66 @@ void stackRows(PivotedQR& qr, int at, const KRows& rows) {
   for (int r = 0; r < rows.rows(); ++r) Eigen::Map<Vec6>(qr.a[at + r]) = rows.row(r).transpose();
 }
 
+/// Below this, λ_min of the equilibrated Gram matrix is not trusted to certify
+/// independent rows (its round-off is ~1e-15; σ_min ≥ 1e-4 is far from it).
+constexpr double kIndependentFloor = 1e-8;
+
+/// Whether a pivoted QR of the nb ≤ 6 equilibrated rows in qr.a would keep
+/// every row, certified without it: with unit rows, the next pivot norm of
+/// step k is at least σ_min/√6 (each row of the unreduced block keeps
+/// ‖yᵀ R₂₂‖ ≥ σ_min), and the rank threshold is at most
+/// thr = max(abs_tol, rel_tol √nb) (|R₀₀| ≤ ‖E B‖_F = √nb), so
+/// λ_min > 6 thr² suffices, and λ_min ≥ 1/tr(G⁻¹) for the Gram matrix
+/// G = E B Bᵀ E (LDLᵀ, ldlt.hpp). Costs nb(nb+1)/2 dot products and an
+/// nb × nb LDLᵀ, with no square root and no serial pivot search.
+bool independentRows(const SolverOptions& o, const PivotedQR& qr, int nb) {
+  Mat6 G;
+  for (int r = 0; r < nb; ++r) {
+    const Eigen::Map<const Vec6> x(qr.a[r]);
+    for (int c = 0; c <= r; ++c) G(r, c) = x.dot(Eigen::Map<const Vec6>(qr.a[c]));
+  }
+  double inv_d[6];
+  if (!ldlt(G, nb, inv_d)) return false;
+  constexpr double ones[6] = {1, 1, 1, 1, 1, 1};  // the rows are unit already
+  const double thr2 = std::max(o.rank_abs_tol * o.rank_abs_tol,
+                               o.rank_rel_tol * o.rank_rel_tol * nb);
+  return equilibratedInverseTrace(G, inv_d, ones, nb) * std::max(6 * thr2, kIndependentFloor) < 1;
+}
+
 /// Rank-revealing compression of the `nb` rows stacked in cp.f:
 /// equilibrate each row (rows already below the absolute tolerance are left
 /// alone, so round-off residue of a redundant row is never blown up into a
 /// fake constraint), then Householder QR with column pivoting, Qᵀ E B Π = R,
 /// stopped at the numerical rank (pivoted_qr.hpp). Sets out = Q₁ᵀ E B = R₁ Πᵀ
 /// — read off R, no product with Q.
-void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out) {
+///
+/// With `whole` (the stack is the body's only one and one segment, it
+/// carries no compliance and its K need not be triangular: not a free joint,
+/// whose split reads R₁₁) and rows certified independent (independentRows), the QR is skipped:
+/// Q = 1, no reflector (cp.f.rank = 0), out = E B. The QR would have kept
+/// every row, and any basis of the same row space serves the split.
+void compress(const SolverOptions& o, Compression& cp, int nb, KRows& out, bool whole,
+              int& certified) {
   PivotedQR& qr = cp.f;
   cp.nrows = nb;
   cp.E.resize(nb);
+  bool all_unit = true;
   for (int r = 0; r < nb; ++r) {
     Eigen::Map<Vec6> row(qr.a[r]);
     const double n = row.norm();
-    const double e = n > o.rank_abs_tol ? 1.0 / n : 1.0;
+    const bool scaled = n > o.rank_abs_tol;
+    all_unit = all_unit && scaled;
+    const double e = scaled ? 1.0 / n : 1.0;
     cp.E[r] = e;
     row *= e;
+  }
+  if (whole && all_unit && nb <= 6 && independentRows(o, qr, nb)) {
+    ++certified;
+    qr.rank = 0;
+    cp.rank = nb;
+    out.resize(nb, 6);
+    for (int r = 0; r < nb; ++r) out.row(r) = Eigen::Map<const Vec6>(qr.a[r]).transpose();
+    return;
   }
   qr.factor(nb, o.rank_abs_tol, o.rank_rel_tol);
   const int rank = qr.rank;
@@ -284,6 +329,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
   ws.redundant = 0;
   ws.nseeds = 0;
   ws.any_soft = false;
+  ws.certified_stacks = 0;
 
   for (int i = model.nbodies - 1; i >= 0; --i) {
     Node& nd = ws.nodes[i];
@@ -299,11 +345,18 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     int nb = 0;
     Compression* cur = &nd.comp[0];
     cur->nseg = 0;
-    auto compressStack = [&]() {
-      compress(o, *cur, nb, nd.K);
-      nd.nK = cur->rank;
+    auto compressStack = [&](bool last) {
       bool soft = false;
       for (int s = 0; s < cur->nseg; ++s) soft |= softSegment(ws, nd, nd.ncomp, cur->seg[s]);
+      // One segment: a constraint's own rows, or one child's handed-up rows
+      // (independent as handed up) — where redundancy is rare and the
+      // certificate pays. Several segments meeting is where it arises (an
+      // axle's normal row and its trailer's, both on the ground): straight to
+      // the QR, with no certificate attempted.
+      const bool whole = o.certify_independent_stacks && last && nd.ncomp == 0 &&
+                         cur->nseg == 1 && !soft && j.type != JointType::Floating;
+      compress(o, *cur, nb, nd.K, whole, ws.certified_stacks);
+      nd.nK = cur->rank;
       cur->soft = false;
       // Dropped rows with no compliance: redundant, their multipliers free.
       cur->nfree = soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
@@ -318,7 +371,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       const int r = g.kind == Segment::Block ? ws.blocks[g.id].rows : ws.nodes[g.id].npass;
       if (r == 0) continue;
       if (nb + r > 12) {  // compress, and carry the kept rows on
-        compressStack();
+        compressStack(false);
         nb = nd.nK;
         if (nb > 0) {
           stackRows(cur->f, 0, nd.K);
@@ -332,7 +385,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       cur->seg[cur->nseg++] = {g.kind, g.id, r};
       nb += r;
     }
-    if (cur && cur->nseg > 0) compressStack();
+    if (cur && cur->nseg > 0) compressStack(true);
 
     // 2. Split the joint: G = K S = U Σ Vᵀ; rows along U₁ fix V₁ᵀ q̈, rows
     //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.

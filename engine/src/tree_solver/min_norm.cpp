@@ -149,7 +149,7 @@ void costOfCompression(TreeWorkspace& ws, int i, int e, Kept kept, const VecX& l
       }
       at += g.rows;
     }
-    for (int k = 0; k < r; ++k) {  // G ← G H_k, H_k = 1 − τ v vᵀ, v = [0…0, 1, essential]
+    for (int k = 0; k < cp.f.rank; ++k) {  // G ← G H_k, H_k = 1 − τ v vᵀ, v = [0…0, 1, essential]
       const double tau = cp.f.tau[k];
       const int pk = cp.f.perm[k];
       double v[12];

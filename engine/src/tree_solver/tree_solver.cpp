@@ -155,6 +155,7 @@ int TreeSolver::loopRows() const { return static_cast<int>(ws_->loops.size()); }
 int TreeSolver::redundantRows() const { return ws_->last_redundant; }
 bool TreeSolver::lastSolveClosedForm() const { return ws_->last_closed_form; }
 bool TreeSolver::lastFactorReused() const { return ws_->last_factor_reused; }
+int TreeSolver::certifiedStacks() const { return ws_->certified_stacks; }
 void TreeSolver::forgetFactor() {
   ws_->factor_record.valid = false;
   ws_->loop_closure_valid = false;

@@ -56,7 +56,7 @@ struct Segment {
 /// forming Q costs O(nrows² · 6).
 struct Compression {
   int nrows = 0;               ///< rows stacked
-  int rank = 0;                ///< rows kept = reflectors stored
+  int rank = 0;                ///< rows kept (= f.rank reflectors, or none: Q = 1)
   PivotedQR f;                 ///< R, reflectors, scalars τ and column pivots Π
   BufVec E;                    ///< row equilibration scales
   int nseg = 0;
@@ -134,14 +134,15 @@ inline void applyReflector(const Compression& cp, int k, BufVec& x) {
   for (int r = k + 1; r < cp.nrows; ++r) x[r] -= t * cp.f.a[r][pk];
 }
 
-/// x ← Qᵀ x (x has cp.nrows entries): H₀ first.
+/// x ← Qᵀ x (x has cp.nrows entries): H₀ first. A stack certified
+/// independent has no reflector (Q = 1, cp.f.rank = 0).
 inline void applyQt(const Compression& cp, BufVec& x) {
-  for (int k = 0; k < cp.rank; ++k) applyReflector(cp, k, x);
+  for (int k = 0; k < cp.f.rank; ++k) applyReflector(cp, k, x);
 }
 
 /// x ← Q x (x has cp.nrows entries): the last reflector first.
 inline void applyQ(const Compression& cp, BufVec& x) {
-  for (int k = cp.rank - 1; k >= 0; --k) applyReflector(cp, k, x);
+  for (int k = cp.f.rank - 1; k >= 0; --k) applyReflector(cp, k, x);
 }
 
 /// How U₂, the left null space of K S (rows handed to the parent), is held.
@@ -295,6 +296,7 @@ struct TreeWorkspace {
   double free_body_lambda_min = 0;        ///< λ_min(I) = σ_min(L)²
   FactorRecord factor_record;             ///< factorPassIfChanged
   bool last_factor_reused = false;        ///< the last solve / projection skipped factorPass
+  int certified_stacks = 0;               ///< stacks of the factor with no QR (backward.cpp, compress)
   bool loop_closure_valid = false;        ///< W, L, Z and its SVD are for the recorded rows (loops.cpp)
 
   // Solver scratch with compile-time maximum sizes.
