@@ -81,6 +81,27 @@ struct SE3 {
   Mat6 toInverseMotionMatrix() const { return inverse().toMotionMatrix(); }
 };
 
+/// out += ᴬX*_B H ᴮX_A for M = {R, p} the pose of B in A: a symmetric
+/// force-from-motion map about B's origin (a spatial or articulated inertia)
+/// expressed about A's origin and added — a body's inertia handed to its
+/// parent in ABA, CRBA and the tree solver. With the force transform
+/// F = [R, p̂R; 0, R] it is F H Fᵀ, done blockwise: rotate the three 3 × 3
+/// blocks, then shear by p̂ — about a third of the multiplications of the two
+/// dense 6 × 6 products. H must be symmetric: its lower-left block is not
+/// read, and the result's lower-left is the transpose of its upper-right.
+inline void addTransformedInertia(const SE3& M, const Mat6& H, Mat6& out) {
+  const Mat3& R = M.R;
+  const Mat3 A = R * H.topLeftCorner<3, 3>() * R.transpose();
+  const Mat3 B = R * H.topRightCorner<3, 3>() * R.transpose();
+  const Mat3 D = R * H.bottomRightCorner<3, 3>() * R.transpose();
+  const Mat3 ph = skew(M.p);
+  const Mat3 Bt = B + ph * D;  // top-right of T H' Tᵀ, T = [1, p̂; 0, 1]
+  out.topRightCorner<3, 3>() += Bt;
+  out.bottomLeftCorner<3, 3>() += Bt.transpose();
+  out.bottomRightCorner<3, 3>() += D;
+  out.topLeftCorner<3, 3>().noalias() += A + ph * B.transpose() - Bt * ph;
+}
+
 /// Spatial cross products: m ×  (motion) and m ×* (force).
 inline Vec6 crossMotion(const Vec6& m, const Vec6& x) {
   return spatial(angular(m).cross(angular(x)),

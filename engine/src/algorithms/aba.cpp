@@ -57,8 +57,7 @@ const VecX& aba(const Model& model, Data& data, const VecX& q, const VecX& v, co
     }
     if (p >= 0) {
       pa.noalias() += Ia * data.c[i];
-      const Mat6 X = data.liMi[i].toInverseMotionMatrix();
-      data.IA[p].noalias() += X.transpose() * Ia * X;
+      addTransformedInertia(data.liMi[i], Ia, data.IA[p]);
       data.pA[p] += data.liMi[i].actForce(pa);
     }
   }

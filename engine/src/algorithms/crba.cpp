@@ -10,10 +10,7 @@ const MatX& crba(const Model& model, Data& data, const VecX& q) {
   for (int i = 0; i < model.nbodies; ++i) data.Ic[i] = model.spatial_inertia[i];
   for (int i = model.nbodies - 1; i >= 0; --i) {
     const int p = model.parent[i];
-    if (p >= 0) {
-      const Mat6 X = data.liMi[i].toInverseMotionMatrix();  // parent → child (motion)
-      data.Ic[p].noalias() += X.transpose() * data.Ic[i] * X;
-    }
+    if (p >= 0) addTransformedInertia(data.liMi[i], data.Ic[i], data.Ic[p]);
   }
   for (int i = 0; i < model.nbodies; ++i) {
     const Joint& ji = model.joints[i];

@@ -112,24 +112,6 @@ void stackBodyRows(const Data& data, const ConstraintData& cdata, const TreeBloc
   }
 }
 
-/// out += Xᵀ H X with X = ᵖXᵢ (motion, parent → child) of M = liMi, i.e.
-/// out += F H Fᵀ with the force transform F = [R, p̂R; 0, R] — done blockwise
-/// (rotate the 3×3 blocks, then shear by p̂), with no 6×6 transform built.
-/// H is symmetric (Pᵀ Ia P), so its lower-left block is never read and the
-/// result's lower-left block is the transpose of its upper-right one.
-void addCongruence(const SE3& M, const Mat6& H, Mat6& out) {
-  const Mat3& R = M.R;
-  const Mat3 A = R * H.topLeftCorner<3, 3>() * R.transpose();
-  const Mat3 B = R * H.topRightCorner<3, 3>() * R.transpose();
-  const Mat3 D = R * H.bottomRightCorner<3, 3>() * R.transpose();
-  const Mat3 ph = skew(M.p);
-  const Mat3 Bt = B + ph * D;  // top-right of T H' Tᵀ, T = [1, p̂; 0, 1]
-  out.topRightCorner<3, 3>() += Bt;
-  out.bottomLeftCorner<3, 3>() += Bt.transpose();
-  out.bottomRightCorner<3, 3>() += D;
-  out.topLeftCorner<3, 3>().noalias() += A + ph * B.transpose() - Bt * ph;
-}
-
 /// Split of a free joint (S = 1, so G = K) without an SVD. The last
 /// compression left K = [R₁₁ R₁₂] Πᵀ with R₁₁ upper triangular and
 /// nonsingular (its pivots passed the rank test), so
@@ -421,7 +403,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
       ws.redundant += nd.nfree;
       ws.seeds[ws.nseeds++] = i;
     }
-    if (p >= 0) addCongruence(data.liMi[i], H, ws.nodes[p].IA);
+    if (p >= 0) addTransformedInertia(data.liMi[i], H, ws.nodes[p].IA);
     ws.any_soft = ws.any_soft || nd.soft;
   }
 }
