@@ -52,6 +52,31 @@ Compared compare(const System& s, const SolverOptions& opt = {}) {
   return c;
 }
 
+/// Every row of every local constraint scaled by 10^u, u uniform in ±4: the
+/// row equilibration must undo it.
+void scaleRowsByDecades(System& s, std::mt19937& rng) {
+  std::uniform_real_distribution<double> decades(-4.0, 4.0);
+  for (auto& c : s.local)
+    for (int r = 0; r < c->rows(); ++r) c->scaleRow(r, std::pow(10.0, decades(rng)));
+}
+
+/// One system solved at (q, v) by a tree solver with default options (fast)
+/// and one with `other` (slow).
+struct SolvedTwice {
+  ConstraintList list;
+  Data data;
+  ConstraintData cd;
+  TreeSolver fast, slow;
+  ConstrainedResult a, b;
+  SolvedTwice(const System& s, const SolverOptions& other)
+      : list(s.list()), data(s.model), cd(s.model, list), fast(s.model, list),
+        slow(s.model, list, other) {
+    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
+    fast.solve(s.model, data, list, cd, s.q, s.v, s.tau, a);
+    slow.solve(s.model, data, list, cd, s.q, s.v, s.tau, b);
+  }
+};
+
 }  // namespace
 
 TEST(TreeSolver, MatchesDenseReferenceOnRandomTrees) {
@@ -490,7 +515,6 @@ TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
   SolverOptions passes_only;
   passes_only.free_body_closed_form = false;
   int closed = 0, fallback = 0, closed_scaled = 0, weak_closed = 0, weak_passes = 0;
-  std::uniform_real_distribution<double> decades(-4.0, 4.0);
   for (int rep = 0; rep < 300; ++rep) {
     // One constraint of 1–6 rows, sometimes with duplicates (redundant: the passes).
     System s = randomSystem(1, true, rng, RowRecipe{rep % 3 == 0 ? 0.3 : 0.0, 0.0, 1});
@@ -509,17 +533,9 @@ TEST(TreeSolver, AFreeBodysClosedFormIsThePassesAnswer) {
       weak_test = 25e-4 * MatX(EK * EK.transpose()).inverse().trace();
     }
     const bool scaled = rep % 2 == 1;
-    if (scaled)
-      for (auto& c : s.local)
-        for (int r = 0; r < c->rows(); ++r) c->scaleRow(r, std::pow(10.0, decades(rng)));
-    const ConstraintList list = s.list();
-    Data data(s.model);
-    ConstraintData cd(s.model, list);
-    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-    TreeSolver fast(s.model, list), slow(s.model, list, passes_only);
-    ConstrainedResult a, b;
-    fast.solve(s.model, data, list, cd, s.q, s.v, s.tau, a);
-    slow.solve(s.model, data, list, cd, s.q, s.v, s.tau, b);
+    if (scaled) scaleRowsByDecades(s, rng);
+    SolvedTwice two(s, passes_only);
+    auto& [list, data, cd, fast, slow, a, b] = two;
     ASSERT_TRUE(a.ok && b.ok) << a.error << b.error;
     EXPECT_FALSE(slow.lastSolveClosedForm());
     (fast.lastSolveClosedForm() ? closed : fallback)++;
@@ -564,7 +580,6 @@ TEST(TreeSolver, AnIndependentStackNeedsNoQr) {
   std::mt19937 rng(43);
   SolverOptions qr_only;
   qr_only.certify_independent_stacks = false;
-  std::uniform_real_distribution<double> decades(-4.0, 4.0);
   int certified = 0, stacks_refused = 0, inconsistent = 0;
   for (int rep = 0; rep < 120; ++rep) {
     const int n = 1 + rep % 13;
@@ -580,17 +595,9 @@ TEST(TreeSolver, AnIndependentStackNeedsNoQr) {
       }
     }
     makeConsistent(s, rng);  // right sides some acceleration satisfies
-    if (rep % 5 == 1)
-      for (auto& c : s.local)
-        for (int r = 0; r < c->rows(); ++r) c->scaleRow(r, std::pow(10.0, decades(rng)));
-    const ConstraintList list = s.list();
-    Data data(s.model);
-    ConstraintData cd(s.model, list);
-    evaluateConstraints(s.model, data, list, cd, 0.0, s.q, s.v);
-    TreeSolver fast(s.model, list), slow(s.model, list, qr_only);
-    ConstrainedResult a, b;
-    fast.solve(s.model, data, list, cd, s.q, s.v, s.tau, a);
-    slow.solve(s.model, data, list, cd, s.q, s.v, s.tau, b);
+    if (rep % 5 == 1) scaleRowsByDecades(s, rng);
+    SolvedTwice two(s, qr_only);
+    auto& [list, data, cd, fast, slow, a, b] = two;
     EXPECT_EQ(slow.certifiedStacks(), 0);
     // Many nearly dependent rows in one tree can leave a residual above the
     // consistency tolerance: then both find it.
@@ -617,7 +624,9 @@ TEST(TreeSolver, AnIndependentStackNeedsNoQr) {
     const bool pa = fast.projectVelocity(s.model, data, list, cd, s.q, va, ma);
     const bool pb = slow.projectVelocity(s.model, data, list, cd, s.q, vb, mb);
     EXPECT_EQ(pa, pb) << "rep " << rep << ": " << fast.lastError() << " | " << slow.lastError();
-    if (pa && pb) EXPECT_LT(relErr(va, vb), tol) << "rep " << rep;
+    if (pa && pb) {
+      EXPECT_LT(relErr(va, vb), tol) << "rep " << rep;
+    }
   }
   EXPECT_GT(certified, 100);
   EXPECT_GT(stacks_refused, 5);
