@@ -337,3 +337,36 @@ TEST(CoreKinematics, KinematicsAreRecomputedExactlyWhenTheStateChanged) {
   forwardKinematicsIfStale(model, data, q, v);
   EXPECT_EQ(data.oMi[model.nbodies - 1].p, Vec3::Constant(7));
 }
+
+// A quaternion off the unit sphere (a caller's q that drifted, or scaled on
+// purpose) stands for the rotation of q/|q|: the poses, the velocities and
+// ABA's accelerations are those of the normalised q (to round-off), and every
+// pose is a rotation. Before, R was the unit-quaternion formula applied to q,
+// no rotation, and the dynamics silently wrong.
+TEST(CoreKinematics, AQuaternionOffTheUnitSphereIsItsNormalisedRotation) {
+  std::mt19937 rng(8);
+  int quaternions = 0;
+  for (const Model& model : models()) {
+    const VecX q = randomConfiguration(model, rng);
+    const VecX v = test::randomVector(model.nv, rng), tau = test::randomVector(model.nv, rng);
+    VecX scaled = q;
+    for (const Joint& j : model.joints) {
+      const int at = j.type == JointType::Floating ? j.idx_q + 3 : j.idx_q;
+      if (j.type != JointType::Floating && j.type != JointType::Ball) continue;
+      scaled.segment<4>(at) *= std::uniform_real_distribution<double>(0.5, 2.0)(rng);
+      ++quaternions;
+    }
+    Data a(model), b(model);
+    forwardKinematics(model, a, q, v);
+    forwardKinematics(model, b, scaled, v);
+    for (int i = 0; i < model.nbodies; ++i) {
+      EXPECT_LT((b.oMi[i].R.transpose() * b.oMi[i].R - Mat3::Identity()).norm(), 1e-14);
+      EXPECT_LT((a.oMi[i].R - b.oMi[i].R).norm(), 1e-14);
+      EXPECT_LT((a.oMi[i].p - b.oMi[i].p).norm(), 1e-14);
+      EXPECT_LT((a.v[i] - b.v[i]).norm(), 1e-13 * (1 + a.v[i].norm()));
+    }
+    const VecX qdd_a = aba(model, a, q, v, tau), qdd_b = aba(model, b, scaled, v, tau);
+    EXPECT_LT((qdd_a - qdd_b).norm(), 1e-11 * (1 + qdd_a.norm()));
+  }
+  EXPECT_GT(quaternions, 10);
+}
