@@ -37,13 +37,13 @@ Reference denseReference(const Model& model, const ConstraintData& cd, const Vec
   // ~1e-17) from becoming a constraint, which a purely relative threshold
   // does when every row is such residue.
   int rank = 0;
-  auto solve = [&rank](const ML& B, const VL& rhs) {
+  auto solve = [&rank](const ML& B, const VL& y) {
     Eigen::JacobiSVD<ML> svd(B, Eigen::ComputeThinU | Eigen::ComputeThinV);
     const auto& sv = svd.singularValues();
     rank = 0;
     while (rank < sv.size() && sv(rank) > std::max(1e-10L * sv(0), 1e-14L)) ++rank;
-    const VL y = (svd.matrixU().leftCols(rank).transpose() * rhs).cwiseQuotient(sv.head(rank));
-    return VL(svd.matrixV().leftCols(rank) * y);
+    const VL z = (svd.matrixU().leftCols(rank).transpose() * y).cwiseQuotient(sv.head(rank));
+    return VL(svd.matrixV().leftCols(rank) * z);
   };
   const VL vd = a + Mih * solve(A * Mih, VL(-cd.abias.cast<long double>() - A * a));
   const VL reaction = Ml * (vd - a);

@@ -3,6 +3,8 @@
 
 #include <appell/model.hpp>
 
+#include <cmath>
+
 namespace appell::detail {
 
 /// The rotation of the unit quaternion q/|q| for any q ≠ 0 — Eigen's
@@ -13,7 +15,12 @@ namespace appell::detail {
 /// dynamics would then be silently wrong together. MuJoCo normalises the
 /// same way in its kinematics.
 inline Mat3 rotationOf(double w, double x, double y, double z) {
-  const double s = 2.0 / (w * w + x * x + y * y + z * z);
+  // The division only off the unit sphere: on it (the integrators keep q
+  // there to ~√N ε) it would lengthen every evaluation's critical path.
+  const double n2 = w * w + x * x + y * y + z * z;
+  double s = 2.0;
+  if (std::abs(n2 - 1.0) > 1e-12) [[unlikely]]
+    s = 2.0 / n2;
   const double xx = s * x * x, yy = s * y * y, zz = s * z * z;
   const double xy = s * x * y, xz = s * x * z, yz = s * y * z;
   const double wx = s * w * x, wy = s * w * y, wz = s * w * z;
