@@ -81,7 +81,7 @@ std::vector<Problem> problems() {
   d.mass = 1.0;
   d.lean = 0.3;
   d.axle_rate = 5.0;
-  SleighParams s = seedSleighParams();
+  SleighParams s = lateralSleighParams();
   s.speed = 0.6;
   s.turn_rate = 0.8;
   return {{"disk", "rolling disk, reversible integrable", rollingDisk(d), {}},

@@ -41,9 +41,9 @@ BuiltScene tiltedDisk() {
   return rollingDisk(p);
 }
 
-/// The seed sleigh on its incline, moving and turning.
+/// The lateral sleigh (Emelyanova & Fufaev 1978) on its incline, moving and turning.
 BuiltScene movingSleigh(bool reduced = false) {
-  SleighParams sp = seedSleighParams();
+  SleighParams sp = lateralSleighParams();
   sp.speed = 0.6;
   sp.turn_rate = 0.8;
   return reduced ? sleighReduced(sp) : sleigh(sp);

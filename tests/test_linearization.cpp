@@ -36,16 +36,16 @@ TEST(Linearization, PendulumSpectrumAtBottomAndTop) {
   }
 }
 
-// Seed sleigh resting across the slope (φ = 0), an equilibrium of the second
+// The lateral sleigh resting across the slope (φ = 0), an equilibrium of the second
 // kind. State on 𝓜: (x, y, φ) and the 2 admissible velocities (u along the
-// blade, ω = φ̇): dimension 5. In the seed's variant the only forces are the
+// blade, ω = φ̇): dimension 5. In the paper's variant the only forces are the
 // weight at G and the lateral blade reaction at P, and P − G is itself lateral:
 // neither has a moment about G, so I_G ω̇ = 0 exactly — yaw is neutral, not
 // pendulum-like. Linearized: δω → δφ̇, δφ → δu̇ = g sin α δφ, δu → δẋ; x and y
 // are free. So L is nilpotent: one Jordan chain (ω, φ, u, x) of length 4 and
 // the free y: nullity(Lᵏ) = 2, 3, 4, 5 for k = 1…4, every eigenvalue 0.
-TEST(Linearization, SeedSleighAcrossTheSlopeIsNilpotent) {
-  const SleighParams p = seedSleighParams(0.3, 0.35);
+TEST(Linearization, LateralSleighAcrossTheSlopeIsNilpotent) {
+  const SleighParams p = lateralSleighParams(0.3, 0.35);
   const BuiltScene s = sleighReduced(p);
   KktSolver solver(s.model, s.constraints);
   const LinearizationResult lin = linearize(s.model, s.constraints, solver, s.q0, VecX::Zero(3));
@@ -65,7 +65,7 @@ TEST(Linearization, SeedSleighAcrossTheSlopeIsNilpotent) {
     Lk = Lk * lin.matrix;
   }
   EXPECT_LT(Lk.norm(), 1e-6 * std::pow(lin.matrix.norm(), 5));
-  // The nonlinear statement behind it: φ̈ = 0 on every state of the seed variant.
+  // The nonlinear statement behind it: φ̈ = 0 on every state of the lateral variant.
   Data data(s.model);
   ConstraintData cd(s.model, s.constraints);
   std::mt19937 rng(5);

@@ -52,7 +52,7 @@ System offsetBall() {
   return s;
 }
 
-// Seed-002 sleigh on an incline: a knife edge with the centre of mass beside
+// Emelyanova–Fufaev sleigh on an incline: a knife edge with the centre of mass beside
 // the blade; it slides down, turns and swings across the slope.
 System sleigh() {
   System s;

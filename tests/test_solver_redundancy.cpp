@@ -1,7 +1,7 @@
 // Rank handling of the dense solvers (and the minimum-norm split of the tree
 // solver, the contract of constrained_dynamics.hpp): redundant rows (minimum-norm λ, counted),
 // inconsistent rows (an error naming the rows, never a wrong answer), rows no
-// motion can influence, and the seed-002 sleigh: equilibrium at φ = 0 with
+// motion can influence, and the Emelyanova–Fufaev sleigh: equilibrium at φ = 0 with
 // λ = ±m g sin α, where the fixed partition ẋ = ẏ cot φ is singular; the
 // coordinate partition re-chooses itself there and stays accurate.
 #include <appell/appell_maggi.hpp>
@@ -145,10 +145,10 @@ TEST(SolverRedundancy, RowsNoMotionCanMoveAreRedundantOrInconsistent) {
   }
 }
 
-// Seed 002: the sleigh on an incline. Blade across the slope (φ = 0, π) with
+// Emelyanova & Fufaev (1978), example 1: the sleigh on an incline. Blade across the slope (φ = 0, π) with
 // the centre of mass straight up or down the slope from the blade: an
 // equilibrium held by the blade alone, λ = ±m g sin α (m: the mass moving in y).
-TEST(SolverRedundancy, Seed002SleighEquilibriumAtSingularPartition) {
+TEST(SolverRedundancy, LateralSleighEquilibriumAtSingularPartition) {
   const double m = 3.0, l = 0.4, alpha = 0.3, mc = 0.05;
   const Model model = test::sleighModel(m, 0.2, l, alpha, mc);
   ConstraintList c{test::knifeEdge(2)};

@@ -107,7 +107,7 @@ inline Model ballModel(double m, const Mat3& I, const Vec3& com, const Vec3& g =
   return b.build();
 }
 
-/// Seed-002 sleigh on an incline of angle α in world coordinates: prismatic x,
+/// Emelyanova–Fufaev sleigh on an incline of angle α in world coordinates: prismatic x,
 /// prismatic y (y down the slope), revolute φ; blade point at the last body's
 /// origin with blade direction e_x (body), centre of mass at distance l
 /// perpendicular to the blade, (0, −l) in the body, so U = m g (y − l cos φ) sin α.

@@ -1,4 +1,4 @@
-"""The Chaplygin sleigh on an incline. Mirrors tests/test_seed_sleigh.cpp
+"""The Chaplygin sleigh on an incline. Mirrors tests/test_sleigh_equilibria.cpp
 (Emelyanova & Fufaev's example, after Neimark & Fufaev, *Dynamics of
 Nonholonomic Systems*, 1972): with the centre of mass perpendicular to the
 blade the sleigh has equilibria "of the second kind" at headings φ = 0, π,
@@ -25,8 +25,8 @@ def heading(q):
     return math.atan2(blade @ DOWN, blade @ E1)
 
 
-def seed_lambda(result):
-    """The blade's lateral force projected on the seed's row (sin φ, −cos φ)."""
+def blade_lambda(result):
+    """The blade's lateral force projected on the paper's row (sin φ, −cos φ)."""
     blade = root_rotation(result.q)[:, 0]
     lateral = np.cross(NORMAL, blade)
     lateral /= np.linalg.norm(lateral)
@@ -50,8 +50,8 @@ def guesses(scene, headings, seed=7):
     return out
 
 
-def test_seed_sleigh_equilibria_of_the_second_kind():
-    scene = appell.load_scene(DATA / "seed_sleigh.urdf")
+def test_lateral_sleigh_equilibria_of_the_second_kind():
+    scene = appell.load_scene(DATA / "lateral_sleigh.urdf")
     assert scene.constraint_names == ["blade", "foot1", "foot2"]
     assert scene.row_labels[0] == "blade.lateral"
     mg = scene.total_mass * 9.81
@@ -64,7 +64,7 @@ def test_seed_sleigh_equilibria_of_the_second_kind():
         assert abs(math.sin(phi)) < 1e-9, phi
         sign = 1 if math.cos(phi) > 0 else -1
         found.add(sign)
-        assert seed_lambda(r) == pytest.approx(sign * mg * math.sin(ALPHA), abs=1e-9 * mg)
+        assert blade_lambda(r) == pytest.approx(sign * mg * math.sin(ALPHA), abs=1e-9 * mg)
         # The three normal rows carry the weight's normal component.
         assert r.lambdas[1] + r.lambdas[2] + r.lambdas[3] == pytest.approx(mg * math.cos(ALPHA), abs=1e-9 * mg)
         assert r.manifold_dimension == 2        # x and y are free
@@ -74,7 +74,7 @@ def test_seed_sleigh_equilibria_of_the_second_kind():
 
 
 def test_find_equilibria_multistart():
-    scene = appell.load_scene(DATA / "seed_sleigh.urdf")
+    scene = appell.load_scene(DATA / "lateral_sleigh.urdf")
     ms = appell.find_equilibria(scene, guesses(scene, [0.5, -0.7, 2.6, 3.6], seed=3))
     assert len(ms.runs) == 4
     assert all(r.converged for r in ms.runs)
@@ -93,12 +93,12 @@ def test_usual_sleigh_has_no_equilibrium_and_the_finder_says_so():
         assert r.force_residual > 1e-3 * mg
 
 
-def test_seed_sleigh_linearization_at_rest_across_the_slope():
+def test_lateral_sleigh_linearization_at_rest_across_the_slope():
     # At φ = 0 the state on the constraint manifold is (x, y, φ; u, ω): k = 5.
     # The linearized flow is nilpotent (tests/test_linearization.cpp: yaw is
     # neutral, δφ drives δu̇ = g sin α δφ, x and y are free): every eigenvalue
     # is zero and L⁵ = 0.
-    scene = appell.load_scene(DATA / "seed_sleigh.urdf")
+    scene = appell.load_scene(DATA / "lateral_sleigh.urdf")
     r = appell.find_equilibrium(scene)
     assert r.converged
     lin = appell.linearize(scene, r.q, np.zeros(scene.nv))

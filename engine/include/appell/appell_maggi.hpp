@@ -1,7 +1,8 @@
 // Dense Appell / Maggi (null-space) formulation — a reference solver, kept forever.
 //
 // Independent quasi-velocities e parametrise the admissible velocities,
-// v = N e + η₀ with A N = 0 and A η₀ = −b (Levi-Civita & Amaldi §56–58, seed 000).
+// v = N e + η₀ with A N = 0 and A η₀ = −b (Levi-Civita & Amaldi,
+// Lezioni di meccanica razionale, vol. II part 2, 1927, §56–58).
 // At the acceleration level this reads  v̇ = N ė + v̇_p  with A v̇_p = −abias,
 // which is the same as N ė + Ṅ e + η̇₀ since abias = Ȧv + ḃ carries every
 // velocity product. Appell's equations ∂S/∂ė = Φ (the Maggi equations) are
@@ -14,7 +15,7 @@
 //   Orthonormal (default): Q₂ of a column-pivoted QR of the equilibrated Aᵀ
 //     (N spans the null space of A exactly, NᵀN = I), v̇_p = Q₁ z the
 //     minimum-norm particular solution. Its conditioning is that of the rows
-//     themselves, so it has no coordinate singularity: at the seed-002 sleigh
+//     themselves, so it has no coordinate singularity: at the Emelyanova–Fufaev sleigh
 //     equilibrium φ = 0 the blade row (sin φ, −cos φ, 0) simply has its
 //     null space spanned by (1, 0, 0) and (0, 0, 1), while the fixed partition
 //     ẋ = ẏ cot φ divides by sin φ = 0.
@@ -64,7 +65,6 @@ class AppellSolver final : public ConstrainedSolver {
                        ConstraintData& cdata, const VecX& q, VecX& v, VecX& impulse) override;
 
   const SolverOptions& options() const { return options_; }
-  const AppellOptions& appellOptions() const { return appell_; }
 
   /// ‖Q₂ᵀ r‖ relative to ‖M v̇‖ + ‖τ − h‖ in the last solve (0 in exact arithmetic).
   double lastRangeResidual() const;

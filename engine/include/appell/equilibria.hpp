@@ -4,7 +4,7 @@
 // vanish. With joint forces τ and gravity, Q(q) = τ − h(q, 0), that is
 //     Q(q) + Aᵀ(q) λ = 0,     g(q) = 0   (the holonomic gaps),
 // nv + n_h equations in nv + m unknowns (θ, λ) (local coordinates
-// q = retract(q̄, θ)). Emelyanova & Fufaev (seed 002) show why the multipliers
+// q = retract(q̄, θ)). Emelyanova & Fufaev (1978, docs/equilibria.md) show why the multipliers
 // must stay among the unknowns: equilibria "of the second kind" are held by
 // nonholonomic reactions alone, and any form that eliminates λ through a
 // partition of the velocities (Chaplygin, Voronets, Appell with a fixed

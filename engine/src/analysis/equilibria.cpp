@@ -2,7 +2,7 @@
 //   F(θ, λ) = [ (Q(q) + Aᵀ(q) λ) / f_s ;  g(q) / ℓ_s ],   q = retract(q_k, θ),
 // re-based at every iterate (θ = 0 at q_k, so the local coordinates stay small).
 // ∂F/∂λ = [Aᵀ; 0]/f_s exactly; ∂F/∂θ by central differences.
-// Why minimum norm: the equilibria form a manifold (seed 002: dimension ≥ the
+// Why minimum norm: the equilibria form a manifold (Emelyanova & Fufaev 1978, docs/equilibria.md: dimension ≥ the
 // number of nonholonomic rows), so J is wide or rank-deficient and the
 // Gauss–Newton step is not unique; the minimum-norm one (complete orthogonal
 // decomposition) moves least, i.e. toward the nearest point of the manifold.

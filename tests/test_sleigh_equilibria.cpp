@@ -1,4 +1,4 @@
-// Seed 002 (Emelyanova & Fufaev), example 1: the Chaplygin sleigh on an
+// Emelyanova & Fufaev (1978; docs/equilibria.md), example 1: the Chaplygin sleigh on an
 // inclined plane. Equilibria of the second kind φ = 0, π with λ = ±m g sin α
 // on the row ẋ sin φ − ẏ cos φ = 0 (the blade across the slope holds the
 // sleigh); the partition ẋ = ẏ cot φ is singular exactly there. The usual
@@ -28,13 +28,13 @@ double headingOf(const VecX& q, double alpha) {
   return std::atan2(blade.dot(f.d), blade.dot(f.e1));
 }
 
-/// Seed λ: the blade's lateral reaction force projected on the seed's row direction.
-double seedLambdaFloating(const EquilibriumResult& r, double alpha) {
+/// The paper's λ: the blade's lateral reaction force projected on the paper's row direction.
+double bladeLambdaFloating(const EquilibriumResult& r, double alpha) {
   const Incline f = inclineFrame(alpha);
   const Vec3 blade = floatingRotation(r.q, 0).col(0);
   const Vec3 lateral = f.n.cross(blade).normalized();  // the contact module's row direction
   const Vec3 force = r.lambda[0] * lateral;
-  return force.dot(seedRowDirection(alpha, headingOf(r.q, alpha)));
+  return force.dot(bladeRowDirection(alpha, headingOf(r.q, alpha)));
 }
 
 std::vector<VecX> headingGuesses(const SleighParams& base, const std::vector<double>& phis,
@@ -64,8 +64,8 @@ std::vector<VecX> headingGuesses(const SleighParams& base, const std::vector<dou
 
 }  // namespace
 
-TEST(SeedSleigh, FloatingFinderFindsPhi0AndPiWithLambda) {
-  const SleighParams p = seedSleighParams(kL, kAlpha);
+TEST(LateralSleigh, FloatingFinderFindsPhi0AndPiWithLambda) {
+  const SleighParams p = lateralSleighParams(kL, kAlpha);
   const BuiltScene s = sleigh(p);
   const double mg = p.mass * 9.81;
   const auto guesses = headingGuesses(p, {0.4, -0.3, 0.9, std::numbers::pi + 0.3, std::numbers::pi - 0.6, 2.4}, true);
@@ -76,7 +76,7 @@ TEST(SeedSleigh, FloatingFinderFindsPhi0AndPiWithLambda) {
     EXPECT_LT(r.gap_residual, 1e-10);
     const double phi = headingOf(r.q, kAlpha);
     EXPECT_LT(std::abs(std::sin(phi)), 1e-9) << "phi = " << phi;
-    const double lam = seedLambdaFloating(r, kAlpha);
+    const double lam = bladeLambdaFloating(r, kAlpha);
     if (std::cos(phi) > 0) {
       found0 = true;
       EXPECT_NEAR(lam, mg * std::sin(kAlpha), 1e-9 * mg);
@@ -94,8 +94,8 @@ TEST(SeedSleigh, FloatingFinderFindsPhi0AndPiWithLambda) {
   EXPECT_TRUE(foundPi);
 }
 
-TEST(SeedSleigh, ReducedFinderSolvesTheSeedEquations) {
-  const SleighParams p = seedSleighParams(kL, kAlpha);
+TEST(LateralSleigh, ReducedFinderSolvesThePapersEquations) {
+  const SleighParams p = lateralSleighParams(kL, kAlpha);
   const BuiltScene s = sleighReduced(p);
   const double mg = p.mass * 9.81;
   const auto guesses = headingGuesses(p, {0.5, -0.7, 2.6, 3.6}, false);
@@ -104,7 +104,7 @@ TEST(SeedSleigh, ReducedFinderSolvesTheSeedEquations) {
   for (const EquilibriumResult& r : ms.runs) {
     ASSERT_TRUE(r.converged) << r.message;
     const double phi = r.q[2];
-    // Seed (3): λ sin φ = 0, m g sin α − λ cos φ = 0, m g l sin α sin φ = 0.
+    // The paper's (3): λ sin φ = 0, m g sin α − λ cos φ = 0, m g l sin α sin φ = 0.
     EXPECT_LT(std::abs(std::sin(phi)), 1e-10);
     EXPECT_NEAR(mg * std::sin(kAlpha) - r.lambda[0] * std::cos(phi), 0.0, 1e-9 * mg);
     if (std::cos(phi) > 0) {
@@ -122,7 +122,7 @@ TEST(SeedSleigh, ReducedFinderSolvesTheSeedEquations) {
   EXPECT_EQ(ms.distinct.size(), ms.runs.size());  // different x, y: all distinct points
 }
 
-TEST(SeedSleigh, UsualSleighHasNoEquilibriumAndTheFinderSaysSo) {
+TEST(LateralSleigh, UsualSleighHasNoEquilibriumAndTheFinderSaysSo) {
   const SleighParams p = usualSleighParams(0.3, kAlpha);
   const double mg = p.mass * 9.81;
   for (bool floating : {true, false}) {
@@ -140,8 +140,8 @@ TEST(SeedSleigh, UsualSleighHasNoEquilibriumAndTheFinderSaysSo) {
 // The Appell solver at φ = 0, where ẋ = ẏ cot φ is singular: with an
 // orthonormal null-space basis (and with a pivoted partition) it holds the
 // sleigh at rest with λ = m g sin α, and agrees with the KKT solve nearby.
-TEST(SeedSleigh, AppellAccurateAtTheSecondKindEquilibrium) {
-  const SleighParams p = seedSleighParams(kL, kAlpha);
+TEST(LateralSleigh, AppellAccurateAtTheSecondKindEquilibrium) {
+  const SleighParams p = lateralSleighParams(kL, kAlpha);
   const BuiltScene s = sleighReduced(p);
   const double mg = p.mass * 9.81;
   AppellOptions partition;

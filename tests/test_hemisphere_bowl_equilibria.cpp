@@ -1,4 +1,4 @@
-// Seed 002 (Emelyanova & Fufaev), example 2: a heavy hemisphere rolling
+// Emelyanova & Fufaev (1978; docs/equilibria.md), example 2: a heavy hemisphere rolling
 // without slipping inside a spherical bowl. The equilibria form the
 // 3-dimensional manifold  ψ = ψ₁,  l₁ sin θ = R sin θ₁  (centre of mass above
 // the contact point; tilted states are held by the no-slip reaction).
@@ -50,7 +50,7 @@ struct Guess {
 
 }  // namespace
 
-TEST(SeedHemisphere, FinderRecoversTheThreeDimensionalManifold) {
+TEST(HemisphereBowl, FinderRecoversTheThreeDimensionalManifold) {
   HemisphereBowlParams base;
   const double R = base.radius, l1 = hemisphereComDistance(base), mg = base.mass * 9.81;
   // Guesses away from the manifold: wrong tilt, wrong azimuth, or both.
@@ -68,7 +68,7 @@ TEST(SeedHemisphere, FinderRecoversTheThreeDimensionalManifold) {
     const EquilibriumResult r = findEquilibrium(s.model, s.constraints, s.q0);
     ASSERT_TRUE(r.converged) << r.message;
     const HemisphereAngles a = hemisphereAngles(p, r.q);
-    // Seed relations.
+    // The paper's relations.
     EXPECT_NEAR(l1 * std::sin(a.tilt), R * std::sin(a.contact_polar), 1e-10);
     if (a.contact_polar > 1e-3) {
       EXPECT_NEAR(angleDiff(a.tilt_azimuth, a.contact_azimuth), 0.0, 1e-8);
@@ -90,7 +90,7 @@ TEST(SeedHemisphere, FinderRecoversTheThreeDimensionalManifold) {
   }
 }
 
-TEST(SeedHemisphere, LinearizationHasExactlyTheZeroEigenvaluesOfTheManifold) {
+TEST(HemisphereBowl, LinearizationHasExactlyTheZeroEigenvaluesOfTheManifold) {
   for (double polar : {0.0, 0.15, 0.35}) {  // θ₁ ≤ asin(l₁/R) ≈ 0.384 for equilibria
     HemisphereBowlParams p;
     p.contact_polar = polar;
