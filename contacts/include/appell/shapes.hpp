@@ -92,7 +92,7 @@ struct Mesh {
   SE3 pose;
   /// The triangles in the mesh frame, scaled (filled by the loader; empty
   /// when the file was not read). FCL's geometry and the vertex contacts of
-  /// a non-smooth contact (polyhedral_contact.hpp) need them.
+  /// a non-smooth contact (vertex_contacts.hpp) need them.
   std::vector<Vec3> vertices;
   std::vector<std::array<int, 3>> triangles;
 };

@@ -77,8 +77,6 @@ struct SE3 {
     X << R, Mat3::Zero(), skew(p) * R, R;
     return X;
   }
-  /// 6×6 matrix of actInv() on motion (ᴮX_A); its transpose maps forces B → A.
-  Mat6 toInverseMotionMatrix() const { return inverse().toMotionMatrix(); }
 };
 
 /// out += ᴬX*_B H ᴮX_A for M = {R, p} the pose of B in A: a symmetric
@@ -116,7 +114,6 @@ inline Mat6 crossMotionMatrix(const Vec6& m) {
   X << skew(angular(m)), Mat3::Zero(), skew(linear(m)), skew(angular(m));
   return X;
 }
-inline Mat6 crossForceMatrix(const Vec6& m) { return -crossMotionMatrix(m).transpose(); }
 
 /// Rigid-body inertia: mass, centre of mass and rotational inertia about the
 /// centre of mass, all in the body frame.
