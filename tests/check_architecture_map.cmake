@@ -1,0 +1,41 @@
+# Fails when a folder of the source tree that holds code (C++, Python,
+# JavaScript, shell) is not named in docs/architecture.md's map — the map is
+# checked against the tree, so a new folder cannot be added without its line.
+#   cmake -DSOURCE_DIR=<repo> -P tests/check_architecture_map.cmake
+file(READ ${SOURCE_DIR}/docs/architecture.md doc)
+string(FIND "${doc}" "## The map" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "docs/architecture.md: no section '## The map'")
+endif()
+string(SUBSTRING "${doc}" ${at} -1 doc)
+string(REGEX MATCH "```\n[^`]*```" map "${doc}")
+if(NOT map)
+  message(FATAL_ERROR "docs/architecture.md: the map section has no ``` block")
+endif()
+
+file(GLOB tops LIST_DIRECTORIES true RELATIVE ${SOURCE_DIR} ${SOURCE_DIR}/*)
+set(missing "")
+foreach(top ${tops})
+  if(NOT IS_DIRECTORY ${SOURCE_DIR}/${top} OR top MATCHES "^(\\.|build|docs$)")
+    continue()
+  endif()
+  file(GLOB_RECURSE files RELATIVE ${SOURCE_DIR}
+       ${SOURCE_DIR}/${top}/*.cpp ${SOURCE_DIR}/${top}/*.hpp ${SOURCE_DIR}/${top}/*.py
+       ${SOURCE_DIR}/${top}/*.js ${SOURCE_DIR}/${top}/*.mjs ${SOURCE_DIR}/${top}/*.sh)
+  foreach(f ${files})
+    if(f MATCHES "/node_modules/|/dist/")
+      continue()
+    endif()
+    get_filename_component(dir ${f} DIRECTORY)
+    string(FIND "${map}" "${dir}/" found)
+    if(found EQUAL -1)
+      list(APPEND missing "${dir}/")
+    endif()
+  endforeach()
+endforeach()
+list(REMOVE_DUPLICATES missing)
+if(missing)
+  list(JOIN missing ", " names)
+  message(FATAL_ERROR "docs/architecture.md's map does not name: ${names}")
+endif()
+message(STATUS "architecture map names every source folder")
