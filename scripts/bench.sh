@@ -21,7 +21,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-peers.sh
-bash scripts/build.sh >/dev/null   # every target, report_peers included once the peers are there
+APPELL_CMAKE_ARGS="-DAPPELL_BUILD_BENCHMARKS=ON" bash scripts/build.sh >/dev/null   # every target, report_peers included once the peers are there
 OUT=bench/results
 mkdir -p "$OUT/data" "$OUT/tables"
 
