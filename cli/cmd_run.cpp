@@ -249,9 +249,33 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
 
 }  // namespace
 
+// SIGINT while it lives sets a flag (RunOptions::stop) instead of killing the
+// process: a run stops after its current step, a sweep's runs stop and no
+// new one starts, and what was finished is still printed.
+namespace {
+
+constexpr int kInterrupted = 130;  // 128 + SIGINT, as a shell reports it
+std::atomic<bool> g_interrupted{false};
+class SigintGuard {
+ public:
+  SigintGuard() : previous_(std::signal(SIGINT, [](int) { g_interrupted = true; })) { g_interrupted = false; }
+  ~SigintGuard() { std::signal(SIGINT, previous_); }
+  SigintGuard(const SigintGuard&) = delete;
+  SigintGuard& operator=(const SigintGuard&) = delete;
+  const std::atomic<bool>& flag() const { return g_interrupted; }
+
+ private:
+  void (*previous_)(int);
+};
+
+}  // namespace
+
 // --sweep: one run per value on every core, a row per run — how it ended,
 // the largest energy-balance error and residual, and the final state — at
 // full precision in csv or json.
+// SIGINT stops the runs in progress after their current step and starts no
+// new one: the table lists every value, the runs not started as "not run",
+// and the exit status is 130.
 int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& args,
              const RunOptions& options, const std::string& format) {
   const Sweep sw = parseSweep(args.text("sweep"));
@@ -259,7 +283,11 @@ int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& a
     RunSummary summary;
     VecX q, v;
     std::string error;
+    bool started = false;
   };
+  const SigintGuard sigint_guard;
+  RunOptions stoppable = options;
+  stoppable.stop = &sigint_guard.flag();
   std::vector<Row> rows(sw.values.size());
   const unsigned workers = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(),
                                                            static_cast<unsigned>(rows.size())));
@@ -271,14 +299,15 @@ int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& a
   std::vector<std::thread> pool;
   for (unsigned w = 0; w < workers; ++w)
     pool.emplace_back([&, w] {
-      for (std::size_t k = w; k < rows.size(); k += workers) {
+      for (std::size_t k = w; k < rows.size() && !sigint_guard.flag().load(); k += workers) {
+        rows[k].started = true;
         try {
           Scene s = base;
           std::vector<int> kept = kept_base;
           applyOverride(s, sw.name, number(sw.values[k]), kept);
           completeVelocities(s, kept);
           checkInitialState(s, args.has("project-initial"), LoadOptions().initial_state_tolerance);
-          rows[k].summary = runScene(s, options, [&](const Simulator& sim) {
+          rows[k].summary = runScene(s, stoppable, [&](const Simulator& sim) {
             rows[k].q = sim.q();
             rows[k].v = sim.v();
           });
@@ -289,7 +318,13 @@ int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& a
     });
   for (std::thread& t : pool) t.join();
   const std::vector<std::string> qn = coordinateNames(base.model, false), vn = coordinateNames(base.model, true);
-  auto status = [](const Row& r) { return !r.error.empty() ? "error" : r.summary.ok ? "ok" : "failed"; };
+  auto status = [](const Row& r) {
+    return !r.started               ? "not run"
+           : !r.error.empty()       ? "error"
+           : r.summary.interrupted  ? "interrupted"
+           : r.summary.ok           ? "ok"
+                                    : "failed";
+  };
   if (format == "json") {
     std::cout << "{\"scene\": \"" << base.source << "\", \"parameter\": \"" << sw.name << "\", \"runs\": [";
     for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -331,6 +366,10 @@ int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& a
                      << std::max(r.summary.max_velocity_residual, r.summary.max_gap_residual);
       std::cout << "\n";
     }
+  }
+  if (sigint_guard.flag().load()) {
+    std::cerr << "appell run: interrupted (SIGINT): the runs finished before it are listed\n";
+    return kInterrupted;
   }
   return std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.error.empty() && r.summary.ok; }) ? 0 : 3;
 }
@@ -397,20 +436,15 @@ int run(int argc, char** argv) {
 
   // SIGINT stops the run after the current step: the state reached is written
   // and flushed, the summary printed, and the exit status is 130.
-  static std::atomic<bool> interrupted{false};
-  interrupted = false;
-  options.stop = &interrupted;
-  struct SigintGuard {
-    void (*previous)(int);
-    SigintGuard() : previous(std::signal(SIGINT, [](int) { interrupted = true; })) {}
-    ~SigintGuard() { std::signal(SIGINT, previous); }
-  } sigint_guard;
+  const SigintGuard sigint_guard;
+  options.stop = &sigint_guard.flag();
   Progress progress(options.duration, !args.has("quiet"));
   auto on_step = [&](const Simulator& sim) { progress.update(sim.time()); };
   RunSummary summary;
   std::ofstream csv;
   std::unique_ptr<TrajectoryWriter> writer;
   if (args.has("out")) {
+    refuseOverwritingInputs("out", args.text("out"), scene);
     csv.open(args.text("out"));
     if (!csv) throw std::runtime_error("cannot write '" + args.text("out") + "'");
     writer = std::make_unique<TrajectoryWriter>(csv, scene);
@@ -443,7 +477,7 @@ int run(int argc, char** argv) {
     for (const std::string& png : writePlots(args.text("out"), defaultPlotDir(args.text("out")), &scene))
       std::cout << "plot         " << png << "\n";
   }
-  if (summary.interrupted) return 130;  // 128 + SIGINT, as a shell reports it
+  if (summary.interrupted) return kInterrupted;
   return summary.ok ? 0 : 3;
 }
 

@@ -344,6 +344,9 @@ int view(int argc, char** argv) {
       args.has("trajectory") ? framesFromTrajectory(scene, args.text("trajectory")) : initialFrame(scene);
   const std::string stem = std::filesystem::path(scene.source).stem().string();
   const std::string out = args.text("out", stem + ".html");
+  refuseOverwritingInputs("out", out, scene,
+                          args.has("trajectory") ? std::vector<std::string>{args.text("trajectory")}
+                                                 : std::vector<std::string>{});
   std::ofstream page(out, std::ios::binary);
   if (!page) throw std::runtime_error("cannot write '" + out + "'");
   page << fill(viewer::pageTemplate(), stem, pageJson(scene, frames), viewer::script());

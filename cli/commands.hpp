@@ -21,6 +21,13 @@ inline const std::set<std::string> kLoadFlags = {"project-initial", "no-joint-li
 /// Loads the scene named by the single positional argument.
 Scene loadFromArgs(const Args& args, bool check_initial = true);
 
+/// Throws UsageError when the output file `out` (given by `option`) is one of
+/// the command's inputs — the scene file, a mesh it loaded, or an extra input
+/// such as a trajectory — compared as files (device and inode), so that
+/// `--out scene.urdf` can never overwrite the scene.
+void refuseOverwritingInputs(const std::string& option, const std::string& out, const Scene& scene,
+                             const std::vector<std::string>& other_inputs = {});
+
 /// A help text with "{integrators}" and "{formulations}" replaced by the
 /// canonical names of integratorTable() and formulationTable() ("a | b | c").
 std::string helpText(const char* text);

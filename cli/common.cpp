@@ -3,6 +3,7 @@
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
 
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -19,6 +20,22 @@ Scene loadFromArgs(const Args& args, bool check_initial) {
   Scene scene = loadScene(args.positional()[0], opt);
   for (const std::string& w : scene.warnings) std::cerr << "appell: warning: " << w << "\n";
   return scene;
+}
+
+void refuseOverwritingInputs(const std::string& option, const std::string& out, const Scene& scene,
+                             const std::vector<std::string>& other_inputs) {
+  std::vector<std::string> inputs = other_inputs;
+  inputs.push_back(scene.source);
+  for (const LinkGeometry& link : scene.geometry)
+    for (const auto* list : {&link.visual, &link.collision})
+      for (const Geometry& g : *list)
+        if (!g.mesh_path.empty()) inputs.push_back(g.mesh_path);
+  std::error_code ec;
+  if (!std::filesystem::exists(out, ec)) return;  // a new file overwrites nothing
+  for (const std::string& input : inputs)
+    if (std::filesystem::equivalent(out, input, ec) && !ec)
+      throw UsageError("--" + option + " '" + out + "' is an input of this command (" + input +
+                       "): it would be overwritten; name another file");
 }
 
 std::string helpText(const char* text) {

@@ -1,6 +1,8 @@
 // appell — run, inspect and analyse nonholonomic multibody scenes from URDF.
 #include "commands.hpp"
 
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -21,6 +23,20 @@ commands:
 'appell <command> --help' describes each command's options; 'appell --version' prints the version.
 )";
 
+// What a command printed is its result: when standard output cannot take it
+// (`> /dev/full`, a closed pipe), that is a failure, said on stderr — never a
+// lost summary with exit status 0. stdio buffers the text, so the error only
+// shows once the buffer is flushed.
+int checkedStdout(const std::string& cmd, int status) {
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+    std::cerr << "appell " << cmd << ": error: cannot write to standard output (" << std::strerror(errno)
+              << "): the output is lost\n";
+    return status == 0 ? 1 : status;
+  }
+  return status;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -35,14 +51,18 @@ int main(int argc, char** argv) {
   }
   const std::string cmd = argv[1];
   try {
-    if (cmd == "run") return run(argc, argv);
-    if (cmd == "info") return info(argc, argv);
-    if (cmd == "equilibria") return equilibria(argc, argv);
-    if (cmd == "linearize") return linearize(argc, argv);
-    if (cmd == "view") return view(argc, argv);
-    if (cmd == "plot") return plot(argc, argv);
-    std::cerr << "appell: unknown command '" << cmd << "'\n" << kUsage;
-    return 2;
+    int status = -1;
+    if (cmd == "run") status = run(argc, argv);
+    if (cmd == "info") status = info(argc, argv);
+    if (cmd == "equilibria") status = equilibria(argc, argv);
+    if (cmd == "linearize") status = linearize(argc, argv);
+    if (cmd == "view") status = view(argc, argv);
+    if (cmd == "plot") status = plot(argc, argv);
+    if (status < 0) {
+      std::cerr << "appell: unknown command '" << cmd << "'\n" << kUsage;
+      return 2;
+    }
+    return checkedStdout(cmd, status);
   } catch (const UsageError& e) {
     std::cerr << "appell " << cmd << ": " << e.what() << " (see appell " << cmd << " --help)\n";
     return 2;

@@ -7,7 +7,8 @@
 #   scripts/fuzz.sh -max_total_time=S  S seconds
 #   FUZZ_TARGET=fuzz_mesh_loader scripts/fuzz.sh …   the mesh loader instead
 # Seeds: every URDF of examples/ and tests/data (scene loader), every mesh of
-# examples/ and tests/data (mesh loader: first byte = format). A crash leaves
+# examples/, tests/data and fuzz/mesh-seeds (mesh loader: first byte = the
+# file's suffix, the rest the file; the gate sniffs the format by content). A crash leaves
 # crash-<sha1> in build-asan/findings; copy it to tests/data/fuzz-regressions/
 # (test_fuzz_regressions loads each file there under every build).
 set -euo pipefail
@@ -21,11 +22,18 @@ mkdir -p "$corpus" build-asan/findings
 if [ "$target" = fuzz_scene_loader ]; then
   find examples tests/data -name '*.urdf' -size -64k -exec cp {} "$corpus"/ \;
 else
+  # First byte: the index of the file's suffix in fuzz_mesh_loader.cpp's
+  # list (the content alone decides the format). fuzz/mesh-seeds holds a file
+  # of each other format assimp recognises by content (NFF, AC3D, OFF, glTF,
+  # X3D, Irrlicht, binary PLY), which the gate must refuse or read.
   i=0
   while IFS= read -r f; do
-    case "$f" in *.stl|*.STL) b='\x00' ;; *.obj) b='\x01' ;; *.ply) b='\x02' ;; *.dae) b='\x03' ;; *) continue ;; esac
+    case "$f" in *.stl|*.STL) b='\x00' ;; *.obj) b='\x01' ;; *.ply) b='\x02' ;; *.dae) b='\x03' ;;
+                 *.nff) b='\x07' ;; *.ac) b='\x08' ;; *.off) b='\x09' ;; *.gltf) b='\x0a' ;; *.glb) b='\x0b' ;;
+                 *) b='\x06' ;; esac
     { printf "$b"; cat "$f"; } > "$corpus/seed$i"; i=$((i + 1))
-  done < <(find examples tests/data -type f \( -name '*.stl' -o -name '*.STL' -o -name '*.obj' -o -name '*.ply' -o -name '*.dae' \) -size -256k)
+  done < <(find examples tests/data fuzz/mesh-seeds -type f \( -name '*.stl' -o -name '*.STL' -o -name '*.obj' \
+             -o -name '*.ply' -o -name '*.dae' -o -path 'fuzz/mesh-seeds/*' -o -path 'tests/data/fuzz-regressions/mesh_*' \) -size -256k)
 fi
 args=("$@")
 [ ${#args[@]} -eq 0 ] && args=(-runs=1000000)

@@ -2,7 +2,8 @@
 # A clang build under AddressSanitizer + UndefinedBehaviorSanitizer (with
 # libFuzzer's coverage, so the fuzz targets share it) into ./build-asan, a
 # representative subset of the suite run in it, then a bounded fuzz run of
-# the scene loader (FUZZ_SECONDS, default 30; 0 skips it). scripts/test.sh
+# the scene loader and one of the mesh loader (FUZZ_SECONDS each, default
+# 30; 0 skips them). scripts/test.sh
 # runs this after the Release tests, so CI does.
 #   The subset: the loader's bad-input, damaged-file and fuzz-finding tests,
 #   the model builder's errors, the allocation-counting tests (counting
@@ -30,4 +31,6 @@ ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E 'package_consume
 seconds=${FUZZ_SECONDS:-30}
 if [ "$seconds" != 0 ]; then
   bash scripts/fuzz.sh -max_total_time="$seconds"
+  # The mesh gate too: every format assimp recognises by content, under any name.
+  FUZZ_TARGET=fuzz_mesh_loader bash scripts/fuzz.sh -max_total_time="$seconds"
 fi

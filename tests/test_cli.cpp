@@ -15,6 +15,7 @@
 #include <iterator>
 #include <sstream>
 
+#include <sys/stat.h>
 #include <unistd.h>
 #include <regex>
 #include <string>
@@ -324,4 +325,98 @@ TEST(Cli, ANormalRowTheJointsHoldIsNotReportedAsPulling) {
   EXPECT_NE(r.output.find("blade                    normal held by the joints"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("would lift off"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("flagged"), std::string::npos) << r.output;
+}
+
+// Issue 41, reproducer 14: `--out` naming the scene overwrote it (exit 0).
+// The output is compared with every input as a file (device and inode), so
+// another spelling of the same path is caught too; the scene is untouched.
+TEST(Cli, OutNamingAnInputIsRefused) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("appell_out_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path scene = dir / "disk.urdf";
+  std::filesystem::copy_file(kDisk, scene);
+  const std::string before = [&] {
+    std::ifstream in(scene);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }();
+  const std::string other_spelling = (dir / "." / "disk.urdf").string();
+  const Result r = sh("run " + scene.string() + " --duration 0.01 --quiet --out " + other_spelling);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--out '" + other_spelling + "' is an input of this command"), std::string::npos)
+      << r.output;
+  std::ifstream in(scene);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), before);
+  std::filesystem::remove_all(dir);
+}
+
+// Issue 41, reproducer 14: a full standard output lost the summary with exit
+// status 0; it is an error now, said on stderr.
+TEST(Cli, AnUnwritableStandardOutputIsAFailure) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+  const Result r = appell::test::runCommand("( " + kAppell + " info " + kDisk + " > /dev/full )");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("appell info: error: cannot write to standard output"), std::string::npos) << r.output;
+  const Result run = appell::test::runCommand("( " + kAppell + " run " + kDisk + " --duration 0.01 --quiet > /dev/full )");
+  EXPECT_EQ(run.status, 1) << run.output;
+}
+
+// Issue 41, reproducer 14: SIGINT during a sweep printed nothing of the
+// finished runs. Now the runs in progress stop after their step, no new one
+// starts, and the table lists every value: the finished ones with their
+// results, the others as "interrupted" or "not run"; the status is 130.
+TEST(Cli, SigintDuringASweepKeepsTheFinishedRuns) {
+  const std::string car = std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf";
+  const Result r = appell::test::runCommand("timeout --preserve-status -s INT 4 " + kAppell + " run " + car +
+                                            " --sweep speed=1:2:2000 --duration 1 --format csv");
+  EXPECT_EQ(r.status, 130) << r.output.substr(0, 2000);
+  std::istringstream in(r.output);
+  std::string line;
+  int ok = 0, not_run = 0, rows = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("speed,status", 0) == 0 || line.find(',') == std::string::npos) continue;
+    ++rows;
+    ok += line.find(",ok,") != std::string::npos;
+    not_run += line.find(",not run,") != std::string::npos;
+  }
+  EXPECT_EQ(rows, 2000) << "every value has its row";
+  EXPECT_GE(ok, 1) << "the runs finished before SIGINT are kept";
+  EXPECT_GE(not_run, 1) << "2000 runs do not finish in 4 s";
+  EXPECT_NE(r.output.find("interrupted (SIGINT)"), std::string::npos);
+}
+
+// Issue 41, reproducer 10: `appell plot` and `view` read a trajectory with no
+// bound (/dev/zero grew at 250 MB/s until memory ran out; a FIFO blocked for
+// ever). Only regular files are read, up to a size limit.
+TEST(Cli, TrajectoryReadersRefuseDevicesPipesAndDirectories) {
+  if (std::filesystem::exists("/dev/zero")) {
+    const Result r = sh("plot /dev/zero");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("/dev/zero: not a regular file"), std::string::npos) << r.output;
+  }
+  const std::string fifo = std::string(APPELL_BINARY_DIR) + "/cli_fifo_" + std::to_string(getpid());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const Result f = appell::test::runCommand("timeout 20 " + kAppell + " plot " + fifo);
+  EXPECT_EQ(f.status, 1) << f.output;  // refused, not blocked (timeout's 124)
+  EXPECT_NE(f.output.find(fifo + ": not a regular file"), std::string::npos) << f.output;
+  std::filesystem::remove(fifo);
+  try {
+    appell::readTrajectory(std::filesystem::temp_directory_path().string());
+    ADD_FAILURE() << "a directory read as a trajectory";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+  }
+}
+
+// Issue 41, reproducer 15: a name with a line break is written quoted, and
+// read back whole (it once split the header into two records).
+TEST(Cli, AHeaderNameWithALineBreakReadsBack) {
+  const std::string csv = std::string(APPELL_BINARY_DIR) + "/cli_newline_" + std::to_string(getpid()) + ".csv";
+  std::ofstream(csv) << "time,\"odd\nname\",x\n0,1,2\n0.5,3,4\n";
+  const appell::TrajectoryTable t = appell::readTrajectory(csv);
+  ASSERT_EQ(t.columns.size(), 3u);
+  EXPECT_EQ(t.columns[1], "odd\nname");
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.rows[1][2], 4.0);
+  std::filesystem::remove(csv);
 }

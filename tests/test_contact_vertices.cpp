@@ -11,6 +11,8 @@
 #include "scene.hpp"
 #include "simulation_helpers.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -380,4 +382,104 @@ TEST(ContactVertices, ARidgeBetweenTheCornersStopsTheRunByName) {
   const RunSummary onto_flat = runScene(boxOverTerrain(flat, "flat", 0.0), o);
   EXPECT_TRUE(onto_flat.ok) << onto_flat.failure;
   EXPECT_EQ(onto_flat.events.size(), 4u) << "four corners land";
+}
+
+namespace {
+
+// A UV sphere of radius r with `rings` × `segments` vertices (plus poles):
+// every vertex is on its convex hull.
+Mesh uvSphere(double r, int rings, int segments) {
+  Mesh m{"scan.stl", Vec3::Ones(), SE3::Identity(), {}, {}};
+  m.vertices.push_back({0, 0, r});
+  for (int i = 1; i <= rings; ++i) {
+    const double th = M_PI * i / (rings + 1);
+    for (int j = 0; j < segments; ++j) {
+      const double ph = 2 * M_PI * j / segments;
+      m.vertices.push_back({r * std::sin(th) * std::cos(ph), r * std::sin(th) * std::sin(ph), r * std::cos(th)});
+    }
+  }
+  m.vertices.push_back({0, 0, -r});
+  const int south = static_cast<int>(m.vertices.size()) - 1;
+  auto at = [&](int i, int j) { return 1 + (i - 1) * segments + (j % segments); };
+  for (int j = 0; j < segments; ++j) {
+    m.triangles.push_back({0, at(1, j), at(1, j + 1)});
+    m.triangles.push_back({south, at(rings, j + 1), at(rings, j)});
+    for (int i = 1; i < rings; ++i) {
+      m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
+// Issue 41, reproducer 9: every hull vertex of a mesh was a contact —
+// 179 402 of them took `appell info` 304 s and 2 GB. A hull of more than
+// kMaxHullContacts vertices is reduced to its support points in that many
+// evenly spread directions: at most 128 contacts, exact in those directions
+// (the farthest vertex along each is kept), and a box-like hull keeps its 8
+// corners however finely its faces are meshed.
+TEST(ContactVertices, AHugeHullIsReducedToItsSupportPointsWithAWarning) {
+  const Mesh sphere = uvSphere(0.1, 299, 600);  // 179 402 vertices
+  ASSERT_EQ(sphere.vertices.size(), 179402u);
+  int hull_vertices = 0;
+  const std::vector<Vec3> kept = contactVertices(sphere, 16, &hull_vertices);
+  EXPECT_EQ(hull_vertices, 179402);
+  EXPECT_LE(kept.size(), static_cast<std::size_t>(kMaxHullContacts));
+  EXPECT_GE(kept.size(), 100u) << "a round hull has a distinct support point in nearly every direction";
+  // Exact in the lattice's directions: the kept set reaches as far as the hull.
+  const double golden = M_PI * (3 - std::sqrt(5.0));
+  for (int k = 0; k < kMaxHullContacts; ++k) {
+    const double z = 1 - (2.0 * k + 1) / kMaxHullContacts, r = std::sqrt(1 - z * z);
+    const Vec3 d(r * std::cos(k * golden), r * std::sin(k * golden), z);
+    double all = -1, reduced = -1;
+    for (const Vec3& v : sphere.vertices) all = std::max(all, d.dot(v));
+    for (const Vec3& v : kept) reduced = std::max(reduced, d.dot(v));
+    EXPECT_EQ(reduced, all) << "direction " << k;
+  }
+  // Every direction: the reduced polytope reaches within R(1 − cos(δ/2)) of
+  // the sphere, δ the lattice's spacing √(4π/K) (1.2 % of R for K = 128).
+  const double spacing = std::sqrt(4 * M_PI / kMaxHullContacts);
+  for (int k = 0; k < 500; ++k) {
+    const Vec3 d = Vec3(std::sin(k * 0.37) * std::cos(k * 1.3), std::sin(k * 0.37) * std::sin(k * 1.3), std::cos(k * 0.37));
+    double reduced = -1;
+    for (const Vec3& v : kept) reduced = std::max(reduced, d.normalized().dot(v));
+    EXPECT_GT(reduced, 0.1 * std::cos(spacing)) << "direction " << k;
+  }
+  // A cube whose faces are meshed with 21 × 21 points each: its 8 corners.
+  Mesh cube{"cube.stl", Vec3::Ones(), SE3::Identity(), {}, {}};
+  for (int axis = 0; axis < 3; ++axis)
+    for (double side : {-1.0, 1.0})
+      for (int i = 0; i <= 20; ++i)
+        for (int j = 0; j <= 20; ++j) {
+          // Each face bulges out as a paraboloid 10⁻³ high (zero at the
+          // corners), so that all its points are hull vertices.
+          const double u = -1 + 0.1 * i, w = -1 + 0.1 * j;
+          Vec3 p;
+          p[axis] = side * (1 + 1e-3 * (2 - u * u - w * w));
+          p[(axis + 1) % 3] = u;
+          p[(axis + 2) % 3] = w;
+          cube.vertices.push_back(p);
+        }
+  cube.triangles = {{0, 1, 2}};
+  int cube_hull = 0;
+  const std::vector<Vec3> corners = contactVertices(cube, 16, &cube_hull);
+  ASSERT_GT(cube_hull, kMaxHullContacts) << "the bulged face points are on the hull";
+  std::set<std::array<int, 3>> seen;
+  for (const Vec3& v : corners)
+    if (std::abs(std::abs(v.x()) - 1) < 1e-12 && std::abs(std::abs(v.y()) - 1) < 1e-12 &&
+        std::abs(std::abs(v.z()) - 1) < 1e-12)
+      seen.insert({v.x() > 0, v.y() > 0, v.z() > 0});
+  EXPECT_EQ(seen.size(), 8u);
+  // The loader's warning, once per contact, through makeVertexContacts.
+  ContactSpec spec;
+  spec.kind = ContactKind::Sliding;
+  spec.body = 0;
+  spec.shape = sphere;
+  spec.options.name = "foot";
+  std::string warning;
+  EXPECT_EQ(makeVertexContacts(spec, 16, &warning).size(), kept.size());
+  EXPECT_EQ(warning, "contact 'foot': the mesh's convex hull has 179402 vertices; its " + std::to_string(kept.size()) +
+                         " support points in 128 evenly spread directions are the contacts");
 }

@@ -7,9 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <regex>
 
 #include <unistd.h>
@@ -301,4 +304,129 @@ TEST(IoErrors, UnexpandedXacroIsNamedOnce) {
   // A plain URDF with a '$' in a name is not xacro.
   EXPECT_EQ(message("<robot name=\"r\">\n" + link + "<link name=\"cost$1\"/></robot>").find("unexpanded"),
             std::string::npos);
+}
+
+// Issue 41, reproducer 1: TinyXML reads `<1 " >` as an unknown node ending
+// at its first '>', but the depth pre-scan used to skip the quote as an
+// attribute value's and see `<1 " >` + 70 000 × `<x>` + `<2 " >` as one tag:
+// the parser then recursed 70 000 deep (stack overflow). The pre-scan now
+// classifies every '<' as the parser does and refuses such junk by its line.
+TEST(IoErrors, JunkNodesTheParserWouldSkipAreRefusedBeforeItNests) {
+  auto message = [](const std::string& xml) { return messageOf(xml, "junk.urdf"); };
+  std::string deep = "<robot name=\"r\">\n<1 \" >";
+  for (int i = 0; i < 70000; ++i) deep += "<x>";
+  deep += "<2 \" >";
+  for (int i = 0; i < 70000; ++i) deep += "</x>";
+  deep += "</robot>";
+  EXPECT_EQ(message(deep).rfind("junk.urdf:2: malformed XML: '<1 \" >' is not an element, an end tag, "
+                                "a comment or a declaration", 0),
+            0u)
+      << message(deep).substr(0, 200);
+  // The small junk node that used to load silently.
+  const std::string link =
+      "<link name=\"a\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" "
+      "iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n";
+  const std::string small = "<robot name=\"r\">\n" + link + "  <1 \" >\n</robot>\n";
+  EXPECT_NE(message(small).find("junk.urdf:3: malformed XML: '<1 \" >'"), std::string::npos) << message(small);
+  // End tags with nothing open are unknown nodes to TinyXML: they must not
+  // lower the count of the 70 000 elements that follow them.
+  std::string unbalanced;
+  for (int i = 0; i < 70000; ++i) unbalanced += "</x>";
+  unbalanced += "<robot name=\"r\">";
+  for (int i = 0; i < 70000; ++i) unbalanced += "<x>";
+  EXPECT_NE(message(unbalanced).find("junk.urdf:1: malformed XML: '</x>' is not an element"),
+            std::string::npos)
+      << message(unbalanced).substr(0, 200);
+  // What the parser accepts stays accepted: a declaration, a DOCTYPE, a
+  // processing instruction, comments with '<' and quotes in them, a quoted
+  // '>' inside an attribute.
+  const std::string fine = "<?xml version=\"1.0\"?>\n<!DOCTYPE robot>\n<?xml-stylesheet href=\"a\"?>\n"
+                           "<robot name=\"a>b\">\n<!-- <1 \" > -->\n" + link + "</robot>\n";
+  EXPECT_EQ(message(fine), "(loaded)");
+}
+
+namespace {
+
+// A binary STL of the triangles `corners` (three per facet).
+void writeBinaryStl(const std::filesystem::path& path, const std::vector<std::array<float, 3>>& corners) {
+  std::ofstream out(path, std::ios::binary);
+  const char header[80] = "binary STL written by test_io_errors";
+  out.write(header, 80);
+  const auto facets = static_cast<std::uint32_t>(corners.size() / 3);
+  out.write(reinterpret_cast<const char*>(&facets), 4);
+  for (std::uint32_t f = 0; f < facets; ++f) {
+    const float normal[3] = {0, 0, 1};
+    out.write(reinterpret_cast<const char*>(normal), 12);
+    for (int c = 0; c < 3; ++c) out.write(reinterpret_cast<const char*>(corners[3 * f + c].data()), 12);
+    const std::uint16_t attributes = 0;
+    out.write(reinterpret_cast<const char*>(&attributes), 2);
+  }
+}
+
+std::string meshMessage(const std::filesystem::path& path) {
+  try {
+    const TriangleMesh m = loadMesh(path.string());
+    return "(loaded " + std::to_string(m.vertices.size()) + " vertices)";
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+}
+
+}  // namespace
+
+// Issue 41, reproducer 11: a NaN vertex used to be welded before the
+// finiteness check (NaN compares equal to every key of the weld's map), so
+// a terrain with one NaN corner loaded with a flipped copy of a triangle
+// and a bogus penetration; ASCII files with nan, inf or 1e300 (infinite as
+// a float) were refused as "mesh has no triangles". Now every vertex is
+// checked as it is read, and the error names it.
+TEST(IoErrors, NonFiniteMeshVerticesAreNamedBeforeAnyWeld) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("appell_nanmesh_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  writeBinaryStl(dir / "terrain.stl", {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {nan, 1, 0}});
+  const std::string m = meshMessage(dir / "terrain.stl");
+  EXPECT_EQ(m.rfind((dir / "terrain.stl").string() + ": vertex 5 of mesh '", 0), 0u) << m;
+  EXPECT_NE(m.find("' is (nan, 1, 0): a mesh vertex must be finite"), std::string::npos) << m;
+
+  std::ofstream(dir / "ascii.stl") << "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                                      "vertex 1 0 0\nvertex 0 1e300 0\nendloop\nendfacet\nendsolid t\n";
+  EXPECT_NE(meshMessage(dir / "ascii.stl").find("vertex 2 of mesh '"), std::string::npos)
+      << meshMessage(dir / "ascii.stl");
+  EXPECT_NE(meshMessage(dir / "ascii.stl").find("is (0, inf, 0): a mesh vertex must be finite"),
+            std::string::npos)
+      << meshMessage(dir / "ascii.stl");
+  std::ofstream(dir / "nan.obj") << "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n";
+  EXPECT_NE(meshMessage(dir / "nan.obj").find("a mesh vertex must be finite"), std::string::npos)
+      << meshMessage(dir / "nan.obj");
+  // A finite vertex placed out of range by the scale is named with both values.
+  writeBinaryStl(dir / "big.stl", {{0, 0, 0}, {1, 0, 0}, {0, 3e38f, 0}});
+  try {
+    loadMesh((dir / "big.stl").string(), Vec3(1, 1e300, 1));
+    ADD_FAILURE() << "an infinite scaled vertex loaded";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("once placed and scaled: a mesh vertex must be finite"),
+              std::string::npos)
+        << e.what();
+  }
+  // The same terrain without the NaN loads with its 4 distinct corners.
+  writeBinaryStl(dir / "good.stl", {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+  EXPECT_EQ(meshMessage(dir / "good.stl"), "(loaded 4 vertices)");
+  std::filesystem::remove_all(dir);
+}
+
+// Issue 41, item 3: the scene's <simulation> numbers are checked where they
+// are read, by attribute and line — a NaN or negative tolerance never reaches
+// the integrator (where a NaN once hung dopri5).
+TEST(IoErrors, SimulationSettingsAreFiniteAndPositive) {
+  const std::string head =
+      "<robot name=\"r\">\n<link name=\"a\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" "
+      "ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n<appell>\n";
+  for (const char* bad : {"tol=\"nan\"", "tol=\"-1\"", "tol=\"inf\"", "dt=\"0\"", "duration=\"-5\""}) {
+    const std::string m = messageOf(head + "<simulation " + bad + "/>\n</appell></robot>", "sim.urdf");
+    EXPECT_EQ(m.rfind("sim.urdf:4: <simulation", 0), 0u) << bad << ": " << m;
+    const std::string attr = std::string(bad).substr(0, std::string(bad).find('='));
+    EXPECT_NE(m.find(attr), std::string::npos) << bad << ": " << m;
+  }
 }

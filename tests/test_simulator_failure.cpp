@@ -197,5 +197,108 @@ TEST(SimulatorFailure, InitialStateIsProjectedOntoTheConstraints) {
   EXPECT_GT(sim.lastImpulse().norm(), 0.0);
 }
 
+// The message of the std::invalid_argument `make` throws ("" if none).
+template <class Make>
+std::string invalidArgument(Make make) {
+  try {
+    make();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Issue 41, reproducer 6: a NaN tolerance made dopri5's step() loop for ever
+// (its error norm NaN, h shrinking to NaN, which `h < h_min` never catches)
+// and dop853 accept every step unchecked; a negative one was accepted. Every
+// option is now checked where the integrator is made, by name.
+TEST(SimulatorFailure, IntegratorOptionsAreFinitePositiveAndOrdered) {
+  const Ball b;
+  ConstraintList c{std::make_shared<RollingBall>("contact", 0, b.R)};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  auto messageFor = [&](IntegratorType type, auto&& change) {
+    IntegratorOptions o;
+    change(o);
+    return invalidArgument([&] {
+      Simulator(b.model, c, std::make_unique<AppellSolver>(b.model, c), type, o);
+    });
+  };
+  for (IntegratorType type : {IntegratorType::DormandPrince54, IntegratorType::DormandPrince853}) {
+    EXPECT_EQ(messageFor(type, [&](IntegratorOptions& o) { o.rtol = nan; }),
+              "IntegratorOptions: rtol must be finite and > 0 (got nan)");
+    EXPECT_EQ(messageFor(type, [](IntegratorOptions& o) { o.rtol = -1; }),
+              "IntegratorOptions: rtol must be finite and > 0 (got -1)");
+    EXPECT_EQ(messageFor(type, [&](IntegratorOptions& o) { o.atol = inf; }),
+              "IntegratorOptions: atol must be finite and > 0 (got inf)");
+    EXPECT_EQ(messageFor(type, [](IntegratorOptions& o) { o.h_min = 1, o.h_max = 0.1; }),
+              "IntegratorOptions: h_min must not exceed h_max (got h_min = 1, h_max = 0.1)");
+    EXPECT_EQ(messageFor(type, [&](IntegratorOptions& o) { o.h_max = nan; }),
+              "IntegratorOptions: h_max must be finite and > 0 (got nan)");
+    EXPECT_EQ(messageFor(type, [](IntegratorOptions& o) { o.safety = 1.5; }),
+              "IntegratorOptions: safety must be in (0, 1] (got 1.5)");
+  }
+  // Fixed-step methods ignore the tolerances but the options are still one
+  // set, checked the same way (a NaN there is a bug in the caller).
+  EXPECT_NE(messageFor(IntegratorType::RK4, [&](IntegratorOptions& o) { o.rtol = nan; }), "");
+  EXPECT_EQ(messageFor(IntegratorType::Leapfrog, [](IntegratorOptions& o) { o.implicit_max_iterations = 0; }),
+            "IntegratorOptions: implicit_max_iterations must be at least 1 (got 0)");
+
+  SimulatorOptions so;
+  so.contacts.gap_tol = nan;
+  EXPECT_EQ(invalidArgument([&] {
+              Simulator(b.model, c, std::make_unique<AppellSolver>(b.model, c), IntegratorType::RK4, {}, so);
+            }),
+            "SimulatorOptions: contacts.gap_tol must be finite and >= 0 (got nan)");
+  so = {};
+  so.projection.max_iterations = 0;
+  EXPECT_EQ(invalidArgument([&] {
+              Simulator(b.model, c, std::make_unique<AppellSolver>(b.model, c), IntegratorType::RK4, {}, so);
+            }),
+            "SimulatorOptions: projection.max_iterations must be at least 1 (got 0)");
+}
+
+// The step controllers themselves never loop on a NaN step and never accept
+// a step whose error estimate is NaN (a field that returns NaN rates once
+// the tolerances scale them: here the integrator is driven directly).
+TEST(SimulatorFailure, AdaptiveStepsRefuseANanStepInsteadOfLooping) {
+  const Ball b;
+  struct FreeFall final : AccelerationField {
+    bool operator()(double, const VecX&, const VecX& v, VecX& vdot) override {
+      vdot = VecX::Zero(v.size());
+      vdot[5] = -9.81;
+      return true;
+    }
+  } field;
+  for (IntegratorType type : {IntegratorType::DormandPrince54, IntegratorType::DormandPrince853}) {
+    const auto integrator = makeIntegrator(type, b.model);
+    double t = 0;
+    VecX q = b.q0, v = b.v0;
+    const StepResult r = integrator->step(field, t, q, v, std::numeric_limits<double>::quiet_NaN());
+    EXPECT_FALSE(r.ok);
+    ASSERT_NE(r.failure, nullptr);
+    EXPECT_STREQ(r.failure, "the step size is not positive and finite");
+    EXPECT_EQ(t, 0.0);
+    EXPECT_EQ(q, b.q0);
+  }
+}
+
+// Issue 41, reproducer 15 (C++ side): a zero quaternion has no rotation
+// (q/|q| is 0/0); setState refuses it by the joint's name.
+TEST(SimulatorFailure, AZeroQuaternionIsRefusedByItsJoint) {
+  const Ball b;
+  ConstraintList c{std::make_shared<RollingBall>("contact", 0, b.R)};
+  Simulator sim(b.model, c, std::make_unique<AppellSolver>(b.model, c), IntegratorType::RK4);
+  VecX q = b.q0;
+  q.segment<4>(3).setZero();
+  const std::string m = invalidArgument([&] { sim.setState(0, q, b.v0); });
+  EXPECT_NE(m.find("the quaternion of joint '"), std::string::npos) << m;
+  EXPECT_NE(m.find("' is zero (it has no rotation)"), std::string::npos) << m;
+  // Off the unit sphere but not zero: accepted (its rotation is that of q/|q|).
+  q = b.q0;
+  q.segment<4>(3) *= 3.0;
+  EXPECT_NO_THROW(sim.setState(0, q, b.v0));
+}
+
 }  // namespace
 }  // namespace appell

@@ -7,6 +7,7 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -44,9 +45,33 @@ std::vector<int> hullVertexIndices(const std::vector<Vec3>& points, const std::s
   return ids;
 }
 
+// The hull vertices farthest along kMaxHullContacts directions of a
+// spherical Fibonacci lattice (vertex_contacts.hpp): z_k = 1 − (2k + 1)/K,
+// azimuth k·π(3 − √5). Ties go to the earlier hull vertex, so the set is
+// deterministic. Kept in hull order.
+std::vector<int> supportPoints(const std::vector<Vec3>& points, const std::vector<int>& hull) {
+  const int K = kMaxHullContacts;
+  const double golden_angle = M_PI * (3.0 - std::sqrt(5.0));
+  std::vector<char> kept(hull.size(), 0);
+  for (int k = 0; k < K; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / K;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Vec3 d(r * std::cos(k * golden_angle), r * std::sin(k * golden_angle), z);
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < hull.size(); ++i)
+      if (d.dot(points[hull[i]]) > d.dot(points[hull[best]])) best = i;
+    kept[best] = 1;
+  }
+  std::vector<int> out;
+  for (std::size_t i = 0; i < hull.size(); ++i)
+    if (kept[i]) out.push_back(hull[i]);
+  return out;
+}
+
 }  // namespace
 
-std::vector<Vec3> contactVertices(const Shape& shape, int rim_points) {
+std::vector<Vec3> contactVertices(const Shape& shape, int rim_points, int* hull_vertices) {
+  if (hull_vertices) *hull_vertices = 0;
   validateShape(shape);
   auto refuse = [&](const std::string& why) -> std::vector<Vec3> {
     throw std::invalid_argument(std::string(shapeName(shape)) + ": " + why);
@@ -72,9 +97,13 @@ std::vector<Vec3> contactVertices(const Shape& shape, int rim_points) {
           },
           [&](const Mesh& m) {
             if (m.triangles.empty()) return refuse("mesh '" + m.file + "': its triangles were not loaded");
+            std::vector<int> hull = hullVertexIndices(m.vertices, "mesh '" + m.file + "'");
+            if (static_cast<int>(hull.size()) > kMaxHullContacts) {
+              if (hull_vertices) *hull_vertices = static_cast<int>(hull.size());
+              hull = supportPoints(m.vertices, hull);
+            }
             std::vector<Vec3> out;
-            for (int id : hullVertexIndices(m.vertices, "mesh '" + m.file + "'"))
-              out.push_back(m.pose.apply(m.vertices[id]));
+            for (int id : hull) out.push_back(m.pose.apply(m.vertices[id]));
             return out;
           },
           [&](const auto&) {
@@ -84,7 +113,7 @@ std::vector<Vec3> contactVertices(const Shape& shape, int rim_points) {
 }
 
 std::vector<std::shared_ptr<ShapeContact>> makeVertexContacts(const ContactSpec& spec,
-                                                              int rim_points) {
+                                                              int rim_points, std::string* warning) {
   const std::string name =
       !spec.options.name.empty()
           ? spec.options.name
@@ -97,7 +126,12 @@ std::vector<std::shared_ptr<ShapeContact>> makeVertexContacts(const ContactSpec&
                                 toString(spec.kind) + "'");
   std::vector<Vec3> vertices;
   try {
-    vertices = contactVertices(spec.shape, rim_points);
+    int hull_vertices = 0;
+    vertices = contactVertices(spec.shape, rim_points, &hull_vertices);
+    if (hull_vertices > 0 && warning)
+      *warning = "contact '" + name + "': the mesh's convex hull has " + std::to_string(hull_vertices) +
+                 " vertices; its " + std::to_string(vertices.size()) + " support points in " +
+                 std::to_string(kMaxHullContacts) + " evenly spread directions are the contacts";
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("contact '" + name + "': " + e.what());
   }

@@ -1,6 +1,12 @@
+// Reading back a trajectory CSV (trajectory_reader.hpp), bounded: only a
+// regular file of at most kMaxTrajectoryBytes is read (`/dev/zero` once grew
+// the table at 250 MB/s until memory ran out, and a FIFO blocked for ever),
+// and a header whose quoted names hold line breaks is one record.
 #include <appell/trajectory_reader.hpp>
 
+#include <algorithm>
 #include <charconv>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -29,6 +35,28 @@ std::vector<std::string> splitCsv(const std::string& line) {
   return fields;
 }
 
+// One CSV record: lines joined while a quoted field is still open (an
+// even number of quotes closes every field; "" inside one is two).
+bool readRecord(std::istream& in, std::string& record) {
+  if (!std::getline(in, record)) return false;
+  std::string more;
+  while (std::count(record.begin(), record.end(), '"') % 2 == 1 && std::getline(in, more)) record += "\n" + more;
+  return true;
+}
+
+void checkReadable(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw std::runtime_error(path + ": no such trajectory file");
+  if (!std::filesystem::is_regular_file(status))
+    throw std::runtime_error(path + ": not a regular file (a directory, device or pipe is not a trajectory)");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxTrajectoryBytes)
+    throw std::runtime_error(path + ": " + std::to_string(size) + " bytes, larger than the " +
+                             std::to_string(kMaxTrajectoryBytes >> 20) +
+                             " MiB a trajectory may have (write fewer rows: appell run --every N)");
+}
+
 }  // namespace
 
 int TrajectoryTable::find(const std::string& name) const {
@@ -51,16 +79,25 @@ std::vector<double> TrajectoryTable::column(int index) const {
 }
 
 TrajectoryTable readTrajectory(const std::string& path) {
+  checkReadable(path);
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open the trajectory file");
   TrajectoryTable table;
   table.source = path;
   std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error(path + ": empty file (no header line)");
+  if (!readRecord(in, line)) throw std::runtime_error(path + ": empty file (no header line)");
   table.columns = splitCsv(line);
   if (table.columns.empty() || table.columns[0] != "time")
     throw std::runtime_error(path + ":1: the header does not start with 'time': not an appell trajectory");
-  for (int lineno = 2; std::getline(in, line); ++lineno) {
+  const long header_lines = 1 + std::count(line.begin(), line.end(), '\n');
+  std::uintmax_t bytes = line.size();
+  for (long lineno = header_lines + 1; std::getline(in, line); ++lineno) {
+    // The file may still be growing (a run writing it): the bound holds for
+    // what is read, not only for the size seen at the start.
+    bytes += line.size() + 1;
+    if (bytes > kMaxTrajectoryBytes)
+      throw std::runtime_error(path + ": more than " + std::to_string(kMaxTrajectoryBytes >> 20) +
+                               " MiB read: larger than a trajectory may be");
     if (line.empty() || line == "\r") continue;
     std::vector<double> row;
     row.reserve(table.columns.size());

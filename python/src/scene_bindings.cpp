@@ -1,5 +1,6 @@
 // Scenes: loading (file or string, LoadOptions as keywords), the model's
 // names, the initial state, and configuration-space helpers.
+#include "arguments.hpp"
 #include "bindings.hpp"
 
 #include <appell/configuration.hpp>
@@ -110,9 +111,14 @@ void bindSettings(py::module_& m) {
                                  "The scene's <simulation> defaults (integrator, dt, tol, "
                                  "duration, formulation).")
       .def_readwrite("integrator", &SimulationSettings::integrator)
-      .def_readwrite("dt", &SimulationSettings::dt)
-      .def_readwrite("tol", &SimulationSettings::tol)
-      .def_readwrite("duration", &SimulationSettings::duration)
+      .def_property("dt", [](const SimulationSettings& s) { return s.dt; },
+                    [](SimulationSettings& s, double x) { s.dt = positiveArgument(x, 0, "settings.dt"); })
+      .def_property("tol", [](const SimulationSettings& s) { return s.tol; },
+                    [](SimulationSettings& s, double x) { s.tol = positiveArgument(x, 0, "settings.tol"); })
+      .def_property("duration", [](const SimulationSettings& s) { return s.duration; },
+                    [](SimulationSettings& s, double x) {
+                      s.duration = positiveArgument(x, 0, "settings.duration");
+                    })
       .def_readwrite("formulation", &SimulationSettings::formulation)
       .def("__repr__", [](const SimulationSettings& s) {
         std::ostringstream o;
@@ -215,11 +221,11 @@ void bindScene(py::module_& m) {
       }, "which"_a, "kind"_a,
            "Index into λ of a constraint's row of this kind or label ('normal', 'tangent1', …).")
       .def_property("q0", [](const Scene& s) { return s.q0; },
-                    [](Scene& s, const VecX& q) { checkSize(q, s.model.nq, "q0"); s.q0 = q; })
+                    [](Scene& s, const VecX& q) { checkVector(q, s.model.nq, "q0"); s.q0 = q; })
       .def_property("v0", [](const Scene& s) { return s.v0; },
-                    [](Scene& s, const VecX& v) { checkSize(v, s.model.nv, "v0"); s.v0 = v; })
+                    [](Scene& s, const VecX& v) { checkVector(v, s.model.nv, "v0"); s.v0 = v; })
       .def_property("tau", [](const Scene& s) { return sceneTau(s); },
-                    [](Scene& s, const VecX& t) { checkSize(t, s.model.nv, "tau"); s.tau = t; },
+                    [](Scene& s, const VecX& t) { checkVector(t, s.model.nv, "tau"); s.tau = t; },
                     "Constant joint forces (nv) from <effort>; empty when none.")
       .def_readwrite("settings", &Scene::settings)
       .def_property_readonly("gravity", [](const Scene& s) { return Vec3(s.model.gravity); })

@@ -1,10 +1,13 @@
 #include "simulation.hpp"
 
+#include "arguments.hpp"
+
 #include <appell/constrained_dynamics.hpp>
 #include <appell/kinematics.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace appell::python {
@@ -19,17 +22,10 @@ void Recording::sample(const Simulator& sim) {
   gap_residual.push_back(sim.gapResidual());
 }
 
-namespace {
-
-double positiveOr(double value, double fallback, const char* what) {
-  if (std::isnan(value)) throw std::invalid_argument(std::string(what) + " is NaN");
-  return value > 0 ? value : fallback;
-}
-
-}  // namespace
-
 Simulation::Simulation(std::shared_ptr<const Scene> scene, const SimulationOptions& options)
-    : scene_(std::move(scene)), options_(options) {
+    : scene_(std::move(scene)), options_(options), watch_(options.max_energy_error) {
+  if (!(options.max_energy_error > 0))
+    throw std::invalid_argument("max_energy_error must be > 0 (or inf: no watch)");
   if (!scene_) throw std::invalid_argument("Simulation: no scene");
   const Scene& s = *scene_;
   const SimulationSettings& set = s.settings;
@@ -37,12 +33,14 @@ Simulation::Simulation(std::shared_ptr<const Scene> scene, const SimulationOptio
       integratorFromString(options.integrator.empty() ? set.integrator : options.integrator);
   const Formulation formulation =
       formulationFromString(options.formulation.empty() ? set.formulation : options.formulation);
-  dt_ = positiveOr(options.dt, set.dt, "dt");
-  IntegratorOptions io;
-  io.rtol = positiveOr(options.rtol, set.tol, "rtol");
-  io.atol = positiveOr(options.atol, io.rtol * 1e-2, "atol");
-  io.h_min = positiveOr(options.h_min, io.h_min, "h_min");
-  io.h_max = positiveOr(options.h_max, io.h_max, "h_max");
+  // The scene's settings are Python attributes too: checked here by name.
+  dt_ = options.dt ? positiveArgument(options.dt, 0, "dt") : positiveArgument(set.dt, 0, "scene.settings.dt");
+  IntegratorOptions io;  // validated (by name) where the Simulator builds its integrator
+  io.rtol = options.rtol ? positiveArgument(options.rtol, 0, "rtol")
+                         : positiveArgument(set.tol, 0, "scene.settings.tol");
+  io.atol = positiveArgument(options.atol, io.rtol * 1e-2, "atol");
+  io.h_min = options.h_min;
+  io.h_max = options.h_max;
   SimulatorOptions so;
   so.project_positions = options.project_positions;
   so.project_velocities = options.project_velocities;
@@ -60,6 +58,7 @@ Simulation::Simulation(std::shared_ptr<const Scene> scene, const SimulationOptio
 
 bool Simulation::setState(double t, const VecX& q, const VecX& v) {
   const bool ok = sim_->setState(t, q, v);
+  watch_.start(*sim_);
   events_.clear();
   collectEvents();
   return ok;
@@ -70,17 +69,35 @@ void Simulation::collectEvents() {
     events_.push_back({e, scene_->constraints[e.constraint]->name()});
 }
 
-StepStatus Simulation::step(double h) {
+StepStatus Simulation::watchedStep(double h) {
+  if (!watch_.enabled()) return sim_->step(h);
+  const double t = sim_->time();
+  const VecX q = sim_->q(), v = sim_->v();
+  StepStatus st = sim_->step(h);
+  if (!st.ok || watch_.check(*sim_)) return st;
+  std::ostringstream why;
+  why << "the work balance (E + losses − work in − E0) is off by " << watch_.deviation() << " J, "
+      << watch_.relative() << " of the energy that moved, after the step to t = " << sim_->time()
+      << " s (bound " << watch_.bound() << "): the integration is diverging — use a smaller step or "
+      << "tolerance; the state is back at t = " << t << " s";
+  setState(t, q, v);  // the last state within the bound (the watch restarts there)
+  st.ok = false;
+  st.message = why.str();
+  return st;
+}
+
+StepStatus Simulation::step(std::optional<double> h) {
+  const double step_size = positiveArgument(h, dt_, "step: h");
   events_.clear();
-  const StepStatus st = sim_->step(h > 0 ? h : dt_);
+  const StepStatus st = watchedStep(step_size);
   collectEvents();
   return st;
 }
 
-StepStatus Simulation::advanceTo(double t_end, double h, Recording* record, int every) {
-  if (h <= 0) h = dt_;
-  if (!std::isfinite(h) || !std::isfinite(t_end))
-    throw std::invalid_argument("advance_to: h must be positive and t_end finite");
+StepStatus Simulation::advanceTo(double t_end, std::optional<double> step_size, Recording* record,
+                                 int every) {
+  const double h = positiveArgument(step_size, dt_, "advance_to: h");
+  if (!std::isfinite(t_end)) throw std::invalid_argument("advance_to: t_end must be finite");
   if (every < 1) throw std::invalid_argument("advance_to: every must be at least 1");
   events_.clear();
   if (record) record->sample(*sim_);
@@ -96,7 +113,7 @@ StepStatus Simulation::advanceTo(double t_end, double h, Recording* record, int 
     const double remaining = t_end - sim_->time();
     const double want = adaptive ? h_suggest : h;
     const bool last = want >= remaining - eps;
-    st = sim_->step(last ? remaining : want);
+    st = watchedStep(last ? remaining : want);
     if (!st.ok) break;
     collectEvents();
     if (adaptive && (!last || st.h_taken < remaining)) h_suggest = st.h_next;

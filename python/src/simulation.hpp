@@ -6,30 +6,35 @@
 // guards a simulation stepped on one thread from being used on another.
 #pragma once
 
+#include <appell/divergence_watch.hpp>
 #include <appell/scene.hpp>
 #include <appell/simulator.hpp>
 
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace appell::python {
 
-/// How to simulate a scene. Empty names and non-positive numbers mean "the
-/// scene's own setting" (SimulationSettings of its <simulation> element).
+/// How to simulate a scene. Empty names and absent numbers mean "the scene's
+/// own setting" (SimulationSettings of its <simulation> element); a number
+/// given must be finite and positive (arguments.hpp), h_min ≤ h_max.
 struct SimulationOptions {
   std::string integrator;          ///< a name of integratorTable()
   std::string formulation;         ///< a name of formulationTable()
-  double dt = 0;                   ///< fixed step / first adaptive step
-  double rtol = 0;                 ///< adaptive: relative tolerance (default: scene tol)
-  double atol = 0;                 ///< adaptive: absolute tolerance (default: rtol / 100)
+  std::optional<double> dt;        ///< fixed step / first adaptive step
+  std::optional<double> rtol;      ///< adaptive: relative tolerance (default: scene tol)
+  std::optional<double> atol;      ///< adaptive: absolute tolerance (default: rtol / 100)
   double h_min = 1e-14;
   double h_max = 0.1;
   bool project_positions = true;
   bool project_velocities = true;
   bool contact_events = true;      ///< unilateral contacts may open (ContactEventOptions)
   double settle_time = ContactEventOptions{}.settle_time;  ///< ContactEventOptions::settle_time
+  /// DivergenceWatch's bound (the run library's default); ∞ switches it off.
+  double max_energy_error = 5e-2;
 };
 
 /// The states a stepping loop passed: one row per sample.
@@ -60,12 +65,17 @@ class Simulation {
 
   /// Simulator::setState; returns its result (false: lastStateError()).
   bool setState(double t, const VecX& q, const VecX& v);
-  /// One step (h ≤ 0: dt()). Clears and refills events().
-  StepStatus step(double h);
+  /// One step of h (absent: dt()). Clears and refills events(). Throws
+  /// std::invalid_argument for an h that is not finite and positive. A step
+  /// after which the work balance is off by more than max_energy_error of the
+  /// energy that moved (DivergenceWatch) is undone and reported as failed.
+  StepStatus step(std::optional<double> h);
   /// Steps until t_end as Simulator::advanceTo does (fixed steps of h, or the
   /// adaptive suggestion), collecting every step's events; when `record` is
   /// given, samples the start and every `every`-th step and the end.
-  StepStatus advanceTo(double t_end, double h, Recording* record = nullptr, int every = 1);
+  /// h absent: dt(); given, it must be finite and positive, and t_end finite.
+  StepStatus advanceTo(double t_end, std::optional<double> h, Recording* record = nullptr,
+                       int every = 1);
   /// Events of the last step() / advanceTo() / setState(), in time order.
   const std::vector<NamedEvent>& events() const { return events_; }
 
@@ -90,12 +100,15 @@ class Simulation {
 
  private:
   void collectEvents();
+  /// One step of the simulator, undone (and failed) if the watch says so.
+  StepStatus watchedStep(double h);
 
   std::shared_ptr<const Scene> scene_;
   SimulationOptions options_;
   double dt_ = 0;
   std::unique_ptr<Simulator> sim_;
   std::vector<NamedEvent> events_;
+  DivergenceWatch watch_;
   // Own workspace for reports, so they never touch the simulator's.
   std::unique_ptr<Data> data_;
   std::unique_ptr<ConstraintData> cdata_;

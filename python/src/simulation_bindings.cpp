@@ -1,6 +1,7 @@
 // Simulation: state in and out as NumPy arrays, stepping with the GIL
 // released, per-contact reports, events, recorded trajectories, joint forces.
 #include "bindings.hpp"
+#include "arguments.hpp"
 #include "simulation.hpp"
 
 #include <pybind11/eigen.h>
@@ -100,9 +101,7 @@ void setJointForces(PySimulation& s, py::object tau) {
     });
   } else {
     const VecX c = tau.cast<VecX>();
-    if (c.size() != nv)
-      throw std::invalid_argument("joint forces must have size nv = " + std::to_string(nv) + ", not " +
-                                  std::to_string(c.size()));
+    checkVector(c, nv, "joint forces");
     s.simulator().setJointForces([c](double, const VecX&, const VecX&, VecX& out) { out = c; });
   }
   // Reports of the current state (λ, v̇) include the new forces.
@@ -180,25 +179,27 @@ void bindSimulation(py::module_& m) {
                       std::optional<std::string> formulation, std::optional<double> dt,
                       std::optional<double> rtol, std::optional<double> atol, double h_min, double h_max,
                       bool project_positions, bool project_velocities, bool contact_events,
-                      double settle_time) {
+                      double settle_time, double max_energy_error) {
              SimulationOptions o;
              o.integrator = integrator.value_or("");
              o.formulation = formulation.value_or("");
-             o.dt = dt.value_or(0);
-             o.rtol = rtol.value_or(0);
-             o.atol = atol.value_or(0);
+             o.dt = dt;
+             o.rtol = rtol;
+             o.atol = atol;
              o.h_min = h_min;
              o.h_max = h_max;
              o.project_positions = project_positions;
              o.project_velocities = project_velocities;
              o.contact_events = contact_events;
              o.settle_time = settle_time;
+             o.max_energy_error = max_energy_error;
              return std::make_unique<PySimulation>(std::move(scene), o);
            }),
            "scene"_a, py::kw_only(), "integrator"_a = py::none(), "formulation"_a = py::none(),
            "dt"_a = py::none(), "rtol"_a = py::none(), "atol"_a = py::none(), "h_min"_a = 1e-14,
            "h_max"_a = 0.1, "project_positions"_a = true, "project_velocities"_a = true,
-           "contact_events"_a = true, "settle_time"_a = ContactEventOptions{}.settle_time)
+           "contact_events"_a = true, "settle_time"_a = ContactEventOptions{}.settle_time,
+           "max_energy_error"_a = 5e-2)
       .def_property_readonly("scene", [](const PySimulation& s) { return std::const_pointer_cast<Scene>(s.scenePtr()); })
       .def_property_readonly("dt", &PySimulation::dt)
       .def_property_readonly("integrator", [](PySimulation& s) { return std::string(toString(s.simulator().integrator().type())); })
@@ -225,16 +226,16 @@ void bindSimulation(py::module_& m) {
            "(called with the GIL held: it serialises threads).")
       // Stepping.
       .def("step", [](PySimulation& s, std::optional<double> h, bool check) {
-        return stepping(s, check, [&] { return s.step(h.value_or(0)); });
+        return stepping(s, check, [&] { return s.step(h); });
       }, "h"_a = py::none(), "check"_a = true,
          "One step of h (default: dt). Raises SimulationError on failure unless check=False.")
       .def("advance_to", [](PySimulation& s, double t_end, std::optional<double> h, bool check) {
-        return stepping(s, check, [&] { return s.advanceTo(t_end, h.value_or(0)); });
+        return stepping(s, check, [&] { return s.advanceTo(t_end, h); });
       }, "t_end"_a, "h"_a = py::none(), "check"_a = true,
          "Steps to t_end (fixed steps of h, or adaptive from h). Returns the last StepStatus.")
       .def("record", [](PySimulation& s, double t_end, std::optional<double> h, int every, bool check) {
         Trajectory tr;
-        tr.status = stepping(s, false, [&] { return s.advanceTo(t_end, h.value_or(0), &tr.rec, every); });
+        tr.status = stepping(s, false, [&] { return s.advanceTo(t_end, h, &tr.rec, every); });
         tr.events = s.events();
         checked(s, tr.status, check);
         return tr;

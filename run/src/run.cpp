@@ -1,4 +1,6 @@
 // The run loop and its summary (run.hpp).
+#include <appell/divergence_watch.hpp>
+
 #include "contact_stats.hpp"
 #include "step_stability.hpp"
 #include "vertex_watch.hpp"
@@ -137,8 +139,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   s.contacts = run_detail::contactStats(scene);
   run_detail::markHeldNormals(s.contacts, scene, sim);
   for (const Actuator& a : scene.actuators) s.actuators.push_back({a.name, 0, a.effort_limit, 0, -1, -1});
-  s.energy0 = sim.energy();
-  s.energy_scale = std::max({std::abs(s.energy0), sim.kineticEnergy(), 1e-12});
+  DivergenceWatch energy_watch(options.max_energy_error);
+  energy_watch.start(sim);
+  s.energy0 = energy_watch.energy0();
+  s.energy_scale = energy_watch.scale();
   s.max_velocity_residual = sim.velocityResidual();
   s.max_gap_residual = sim.gapResidual();
   s.max_redundant = sim.redundantRows();
@@ -186,7 +190,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   // The last state within the divergence bound, to go back to (sized once).
   double t_good = sim.time();
   VecX q_good = sim.q(), v_good = sim.v();
-  const bool watch = std::isfinite(options.max_energy_error);
+  const bool watch = energy_watch.enabled();
   const bool watch_residual = std::isfinite(options.max_residual);
   run_detail::VertexWatch vertices(scene);  // boxes and meshes on terrain meshes
   bool restored = false;  // went back to the last good state (its loss counters restart)
@@ -198,13 +202,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
                   run_detail::stepStabilityCause(scene, sim, options);
       break;
     }
-    const double work_in = sim.jointWork() + sim.supportWork();
-    const double deviation =
-        std::abs(sim.energy() + sim.impactEnergyLoss() + sim.frictionWork() - work_in - s.energy0);
-    s.energy_scale = std::max({s.energy_scale, std::abs(sim.energy()), std::abs(sim.jointWork()),
-                               std::abs(sim.supportWork())});
+    const bool diverged = !energy_watch.check(sim);
+    const double deviation = energy_watch.deviation();
+    s.energy_scale = energy_watch.scale();
     std::string uncovered;
-    const bool diverged = watch && !(deviation <= options.max_energy_error * s.energy_scale);
     const double residual = std::max(sim.velocityResidual(), sim.gapResidual());
     const bool drifted = watch_residual && !(residual <= options.max_residual);
     if (diverged || drifted || !vertices.check(sim, uncovered)) {
@@ -220,8 +221,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
         // long for a stiff moment): stop before the numbers blow up.
         why << (s.passive ? "the energy error of this passive scene reached "
                           : "the work balance of this driven scene (E + losses − work in − E0) is off by ")
-            << deviation / s.energy_scale
-            << " (relative) at t = " << sim.time() << " s, beyond the bound "
+            << deviation << " J, " << energy_watch.relative()
+            << " of the energy that moved (kinetic, potential exchanged, work) at t = " << sim.time() << " s, beyond the bound "
             << options.max_energy_error
             << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
       } else {
@@ -253,7 +254,6 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     s.max_redundant = std::max(s.max_redundant, sim.redundantRows());
     run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
     sampleActuators(s, scene, sim);
-  sampleActuators(s, scene, sim);
     ++s.samples;
     // A step that ends at an event is always a sample: each event is a row.
     const bool sampled = step % options.output_every == 0 || !sim.events().empty();

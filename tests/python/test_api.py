@@ -73,7 +73,7 @@ def test_errors_keep_the_cpp_message(tmp_path):
         appell.Simulation(scene, integrator="adams_bashforth")
     with pytest.raises(ValueError, match="unknown formulation"):
         appell.Simulation(scene, formulation="lagrange")
-    with pytest.raises(ValueError, match="settle_time must be finite and ≥ 0"):
+    with pytest.raises(ValueError, match="contacts.settle_time must be finite and >= 0"):
         appell.Simulation(scene, settle_time=-1.0)
     sim = appell.Simulation(scene)
     with pytest.raises(ValueError, match="q must have size nq = 7"):

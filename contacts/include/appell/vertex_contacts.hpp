@@ -18,7 +18,19 @@
 //   Mesh      the vertices of the convex hull of its triangles (Qhull:
 //             Barber, Dobkin & Huhdanpaa, "The Quickhull algorithm for convex
 //             hulls", ACM TOMS 1996); a non-convex mesh foot touches with its
-//             hull's vertices on a convex support
+//             hull's vertices on a convex support. A hull of more than
+//             kMaxHullContacts vertices (a scanned or finely tessellated
+//             part: 10⁵ of them) is reduced to its support points in
+//             kMaxHullContacts directions spread evenly over the sphere (a
+//             spherical Fibonacci lattice: González, "Measurement of areas on
+//             a sphere using Fibonacci and latitude–longitude lattices",
+//             Math. Geosciences 2010): the vertex farthest along each
+//             direction. The reduced set is the contact set of a polytope
+//             inscribed in the hull whose support function is exact in those
+//             directions; for a round hull of radius R the gap it leaves is
+//             about R(1 − cos(δ/2)), δ ≈ √(4π/K) the directions' spacing
+//             (1.2 % of R for K = 128). Every hull corner whose normal cone
+//             holds one of the directions is kept — all 8 of a box.
 //   Cylinder  its two rims as regular polygons of `rim_points` vertices (a
 //             prism: standing on a face is exact; rolling on a rim is not —
 //             a rim that rolls is a `disk` contact)
@@ -35,20 +47,28 @@
 #include <appell/contacts.hpp>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace appell {
 
+/// At most this many vertex contacts for a mesh (see above).
+constexpr int kMaxHullContacts = 128;
+
 /// Candidate contact vertices of a box, cylinder or mesh (body frame).
 /// Throws std::invalid_argument naming the shape for any other shape, a mesh
-/// without triangles, or a mesh whose vertices span no volume or area.
-std::vector<Vec3> contactVertices(const Shape& shape, int rim_points = 16);
+/// without triangles, or a mesh whose vertices span no volume or area. When
+/// a mesh's hull had to be reduced, `hull_vertices` (if given) receives the
+/// hull's own vertex count, else 0.
+std::vector<Vec3> contactVertices(const Shape& shape, int rim_points = 16, int* hull_vertices = nullptr);
 
 /// One point contact per candidate vertex of spec.shape, each with spec's
 /// support, μ, restitution and unilateral flag, named "<spec name>/v<k>".
 /// spec.kind must be Sliding or Rolling. Throws std::invalid_argument naming
-/// the contact.
+/// the contact. When a mesh hull was reduced, `warning` (if given) receives
+/// one line saying so (the loader's warning); it is left alone otherwise.
 std::vector<std::shared_ptr<ShapeContact>> makeVertexContacts(const ContactSpec& spec,
-                                                              int rim_points = 16);
+                                                              int rim_points = 16,
+                                                              std::string* warning = nullptr);
 
 }  // namespace appell

@@ -47,6 +47,11 @@ void configurationRate(const Model& model, const VecX& q, const VecX& v, VecX& q
 /// Renormalise every quaternion (after loading user input; not part of stepping).
 void normalizeQuaternions(const Model& model, VecX& q);
 
+/// The first joint whose quaternion has no direction (|q|² zero or below the
+/// smallest normal double, where q/|q| is undefined), or −1. Quaternions off
+/// the unit sphere are otherwise accepted (a rotation is that of q/|q|).
+int degenerateQuaternionJoint(const Model& model, const VecX& q);
+
 /// A random configuration: angles in [−π, π], displacements in [−1, 1],
 /// uniformly random unit quaternions.
 VecX randomConfiguration(const Model& model, std::mt19937& rng);

@@ -105,6 +105,11 @@ struct IntegratorOptions {
   int implicit_max_iterations = 30;
 };
 
+/// Throws std::invalid_argument naming the first option that is not finite
+/// and positive (rtol, atol, h_min, h_max, safety ∈ (0, 1], implicit_tol,
+/// implicit_max_iterations ≥ 1) or h_min > h_max. makeIntegrator calls it.
+void validateOptions(const IntegratorOptions& options);
+
 struct StepResult {
   bool ok = true;            ///< false: the state became non-finite or the step fell below h_min
   double h_taken = 0;        ///< step actually taken (0 if !ok)
@@ -147,6 +152,7 @@ class Integrator {
   }
 };
 
+/// Throws std::invalid_argument for options validateOptions() refuses.
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type, const Model& model,
                                            const IntegratorOptions& options = {});
 

@@ -48,6 +48,11 @@ struct SimulatorOptions {
   ContactEventOptions contacts;    ///< unilateral contacts: events, impacts
 };
 
+/// Throws std::invalid_argument naming the first option that is NaN, infinite,
+/// negative where it must not be, or an iteration count below one
+/// (simulator/options.cpp). The Simulator's constructor calls it.
+void validateOptions(const SimulatorOptions& options);
+
 struct StepStatus {
   bool ok = true;
   std::string message;   ///< why !ok (empty on success)

@@ -43,6 +43,11 @@ DormandPrince54::DormandPrince54(const Model& model, const IntegratorOptions& op
 StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) {
   StepResult r;
   dense_ = false;
+  if (!(h > 0) || !std::isfinite(h)) {  // NaN would pass every `h < h_min` below
+    r.ok = false;
+    r.failure = "the step size is not positive and finite";
+    return r;
+  }
   h = std::min(h, opt_.h_max);
   coordinateScales(model_, q, scale_q_);
   if (!firstStage(model_, f, t, q, v, have_fsal_, theta_, kth_[0], kv_[0], rates_[0], r)) {
@@ -103,8 +108,8 @@ StepResult DormandPrince54::step(AccelerationField& f, double& t, VecX& q, VecX&
       return r;
     }
     ++r.rejected;
-    h *= field_ok ? std::clamp(opt_.safety * std::pow(err, -0.2), 0.1, 0.9) : 0.25;
-    if (h < opt_.h_min) {
+    h *= field_ok && std::isfinite(err) ? std::clamp(opt_.safety * std::pow(err, -0.2), 0.1, 0.9) : 0.25;
+    if (!(h >= opt_.h_min)) {  // also a NaN h: never loop on it
       r.ok = false;
       r.h_next = h;
       have_fsal_ = false;

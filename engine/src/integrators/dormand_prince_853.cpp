@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace appell::detail {
 
@@ -82,6 +83,11 @@ void DormandPrince853::stageState(int s, double h, const VecX& q, const VecX& v)
 StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) {
   StepResult r;
   dense_ = extra_ = false;
+  if (!(h > 0) || !std::isfinite(h)) {  // NaN would pass every `h < h_min` below
+    r.ok = false;
+    r.failure = "the step size is not positive and finite";
+    return r;
+  }
   h = std::min(h, opt_.h_max);
   coordinateScales(model_, q, scale_q_);
   // FSAL: the last step's f(t + h, y₁) is this step's k₁ — moved only now,
@@ -133,7 +139,10 @@ StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX
         e3 += std::pow(err3_th_[i] / sq, 2) + std::pow(err3_v_[i] / sv, 2);
       }
       const double denom = e5 + 0.01 * e3;
-      err = denom > 0 ? h * e5 / std::sqrt(denom * 2.0 * model_.nv) : 0.0;
+      // A NaN or infinite sum is no error control: reject (not err = 0).
+      err = denom > 0 && std::isfinite(denom) ? h * e5 / std::sqrt(denom * 2.0 * model_.nv)
+            : denom == 0                        ? 0.0
+                                                : std::numeric_limits<double>::infinity();
     }
     if (field_ok && err <= 1.0) {
       q_start_ = q;  // kept for the dense output
@@ -157,8 +166,8 @@ StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX
       return r;
     }
     ++r.rejected;
-    h *= field_ok ? std::clamp(opt_.safety * std::pow(err, -1.0 / 8), 0.1, 0.9) : 0.25;
-    if (h < opt_.h_min) {
+    h *= field_ok && std::isfinite(err) ? std::clamp(opt_.safety * std::pow(err, -1.0 / 8), 0.1, 0.9) : 0.25;
+    if (!(h >= opt_.h_min)) {  // also a NaN h: never loop on it
       r.ok = false;
       r.h_next = h;
       have_fsal_ = false;

@@ -33,6 +33,7 @@ IntegratorType integratorFromString(const std::string& name) {
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type, const Model& model,
                                            const IntegratorOptions& options) {
+  validateOptions(options);
   switch (type) {
     case IntegratorType::SymplecticEuler: return std::make_unique<detail::SymplecticEuler>(model);
     case IntegratorType::Leapfrog: return std::make_unique<detail::Leapfrog>(model, options);

@@ -1,6 +1,7 @@
 #include <appell/configuration.hpp>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace appell {
@@ -252,6 +253,15 @@ VecX randomConfiguration(const Model& model, std::mt19937& rng) {
     }
   }
   return q;
+}
+
+int degenerateQuaternionJoint(const Model& model, const VecX& q) {
+  for (int k = 0; k < static_cast<int>(model.joints.size()); ++k) {
+    const Joint& j = model.joints[k];
+    const int at = j.type == JointType::Floating ? j.idx_q + 3 : j.type == JointType::Ball ? j.idx_q : -1;
+    if (at >= 0 && !(q.segment<4>(at).squaredNorm() >= std::numeric_limits<double>::min())) return k;
+  }
+  return -1;
 }
 
 }  // namespace appell

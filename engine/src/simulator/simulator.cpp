@@ -19,8 +19,7 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   if (!solver_) throw std::invalid_argument("Simulator: no constrained solver given");
   for (const auto& c : constraints_)
     if (!c) throw std::invalid_argument("Simulator: the constraint list holds a null constraint");
-  if (!(options_.contacts.settle_time >= 0) || !std::isfinite(options_.contacts.settle_time))
-    throw std::invalid_argument("Simulator: contacts.settle_time must be finite and ≥ 0 (seconds)");
+  validateOptions(options_);
   data_ = std::make_unique<Data>(
       model_, solver_->usesDenseRows() ? MassMatrix::Sized : MassMatrix::None);
   // Dense storage (m × nv) only for the formulations that assemble A.
@@ -64,6 +63,9 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
                                 std::to_string(model_.nv));
   if (!std::isfinite(t) || !q.allFinite() || !v.allFinite())
     throw std::invalid_argument("Simulator::setState: non-finite time, q or v");
+  if (const int j = degenerateQuaternionJoint(model_, q); j >= 0)
+    throw std::invalid_argument("Simulator::setState: the quaternion of joint '" + model_.joint_names[j] +
+                                "' is zero (it has no rotation)");
   t_ = t;
   q_ = q;
   v_ = v;

@@ -4,6 +4,7 @@
 // back to the same double, and read here with std::from_chars).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,8 +23,13 @@ struct TrajectoryTable {
   std::vector<double> column(int index) const;
 };
 
-/// Reads a trajectory CSV (RFC 4180 quoting in the header). Throws
-/// std::runtime_error naming file, line and reason on a malformed file.
+/// Larger trajectory files are refused (2 GiB: 10⁷ rows of 25 columns).
+constexpr std::uintmax_t kMaxTrajectoryBytes = std::uintmax_t{2} << 30;
+
+/// Reads a trajectory CSV (RFC 4180 quoting in the header, line breaks inside
+/// quoted names included). Throws std::runtime_error naming file, line and
+/// reason on a malformed file, and for anything but a regular file of at most
+/// kMaxTrajectoryBytes.
 TrajectoryTable readTrajectory(const std::string& path);
 
 }  // namespace appell

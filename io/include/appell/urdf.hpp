@@ -73,11 +73,15 @@ std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
 /// 10⁵ folders in all) holding a package.xml whose <name> is NAME. Empty if none.
 std::string findPackage(const std::string& name, const LoadOptions& options = {});
 
-/// Reads a triangle mesh (STL, OBJ, Collada/DAE and the other formats assimp
-/// reads), applies node transforms and `scale`. Collada files keep their own
-/// up axis (the file's coordinates are taken as they are, as ROS tools do)
-/// and their unit. Throws SceneError for unreadable files and meshes with no
-/// triangles.
+/// Reads a triangle mesh — STL (binary or ASCII), OBJ, PLY or Collada,
+/// recognised by content, whatever the file's name — applies node transforms
+/// and `scale`. Collada files keep their own up axis (the file's coordinates
+/// are taken as they are, as ROS tools do) and their unit. Throws SceneError
+/// naming the file for: a missing file, a directory or device, more than
+/// 256 MiB, any other format, declared sizes the file cannot hold, a Collada
+/// node graph too deep, cyclic or too large once expanded, polygons of more
+/// than 1024 corners, a non-finite vertex (named), no triangles
+/// (docs/hardening.md lists every bound).
 TriangleMesh loadMesh(const std::string& path, const Vec3& scale = Vec3::Ones());
 
 /// Result of checkInitialState.

@@ -218,8 +218,12 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
         throw std::invalid_argument("contact '" + spec.options.name +
                                     "': 'points' applies to a smooth shape on a terrain; a " +
                                     shapeName(spec.shape) + " touches with its vertices");
-      else
-        made = makeVertexContacts(spec, c.rim_points > 0 ? c.rim_points : 16);
+      else {
+        std::string reduced;
+        made = makeVertexContacts(spec, c.rim_points > 0 ? c.rim_points : 16, &reduced);
+        if (!reduced.empty())
+          scene.warnings.push_back(src.file + ":" + std::to_string(c.element->Row()) + ": " + reduced);
+      }
     } catch (const std::invalid_argument& e) {
       fail(src, c.element, std::string(e.what()) + " (shape: " + shapeName(spec.shape) + " from " +
                                origin.shape_source + ")");

@@ -11,6 +11,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 #include <vector>
@@ -18,47 +20,87 @@
 
 namespace appell::io {
 
-/// The deepest element nesting of the text, counted without parsing (the
-/// parser recurses per level: a file nested 10⁵ deep would overflow its
-/// stack). Comments, CDATA, declarations and quoted attribute values are
-/// skipped; an error in them is left to the parser.
-static int nestingDepth(const std::string& xml, int limit) {
+// The XML pre-scan: the deepest element nesting, counted the way TinyXML's
+// recursive parser nests (one C++ frame per element level: a file nested 10⁵
+// deep overflows its stack), without parsing. Each '<' is classified as
+// TinyXML 2.6's TiXmlNode::Identify does:
+//   "<?xml"          declaration — ends at its first '>' here (TinyXML may
+//                    read on inside a quoted version: we never count less)
+//   "<!--", "<![CDATA["  comment / CDATA — end at "-->" / "]]>", as there
+//   "<!", "<?"       DOCTYPE, processing instruction: an unknown node that
+//                    ends at the first '>', quotes or not
+//   "</"             an end tag (at depth 0 TinyXML reads it as an unknown node)
+//   '<' + a letter, '_' or a byte ≥ 127 (TinyXML's IsAlpha)   an element,
+//                    whose tag ends at the first '>' outside a quoted value
+//                    (TinyXML reads quoted attribute values whole too, and
+//                    refuses a quote anywhere else in a tag)
+//   anything else    also an unknown node to TinyXML, ending at the first
+//                    '>' — `<1 " >` is one — refused here as junk: skipping
+//                    its quote as an attribute's once made the pre-scan see
+//                    one tag where the parser then nested 70 000 elements.
+namespace {
+
+bool startsWith(const std::string& xml, std::size_t i, const char* prefix, bool ignore_case = false) {
+  for (std::size_t k = 0; prefix[k]; ++k) {
+    if (i + k >= xml.size()) return false;
+    const char c = xml[i + k];
+    const bool same = ignore_case ? std::tolower(static_cast<unsigned char>(c)) == prefix[k] : c == prefix[k];
+    if (!same) return false;
+  }
+  return true;
+}
+
+// The end of an element's start tag (the '>' outside quoted values), or npos.
+std::size_t elementTagEnd(const std::string& xml, std::size_t i) {
+  char quote = 0;
+  for (std::size_t j = i + 1; j < xml.size(); ++j) {
+    const char c = xml[j];
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      return j;
+    }
+  }
+  return std::string::npos;
+}
+
+[[noreturn]] void junkNode(const XmlSource& src, const std::string& xml, std::size_t i) {
+  const long line = 1 + std::count(xml.begin(), xml.begin() + static_cast<long>(i), '\n');
+  const std::size_t end = xml.find('>', i);
+  const std::string node = xml.substr(i, end == std::string::npos ? 16 : std::min<std::size_t>(end - i + 1, 64));
+  throw SceneError(src.file + ":" + std::to_string(line) + ": malformed XML: '" + clipped(node) +
+                   "' is not an element, an end tag, a comment or a declaration");
+}
+
+}  // namespace
+
+static int nestingDepth(const XmlSource& src, const std::string& xml, int limit) {
   int depth = 0, deepest = 0;
   const std::size_t n = xml.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (xml[i] != '<') continue;
-    if (xml.compare(i, 4, "<!--") == 0) {
-      const auto end = xml.find("-->", i + 4);
-      if (end == std::string::npos) break;
-      i = end + 2;
-      continue;
+  for (std::size_t i = xml.find('<'); i < n; i = xml.find('<', i + 1)) {
+    std::size_t end = std::string::npos;
+    if (startsWith(xml, i, "<!--")) {
+      end = xml.find("-->", i + 4);
+    } else if (startsWith(xml, i, "<![CDATA[")) {
+      end = xml.find("]]>", i + 9);
+    } else if (startsWith(xml, i, "<?xml", true) || startsWith(xml, i, "<!") || startsWith(xml, i, "<?")) {
+      end = xml.find('>', i);
+    } else if (startsWith(xml, i, "</")) {
+      end = xml.find('>', i);
+      if (depth == 0) junkNode(src, xml, i);  // an end tag with no element open
+      --depth;
+    } else if (i + 1 < n && (std::isalpha(static_cast<unsigned char>(xml[i + 1])) || xml[i + 1] == '_' ||
+                             static_cast<unsigned char>(xml[i + 1]) >= 127)) {
+      end = elementTagEnd(xml, i);
+      if (end != std::string::npos && xml[end - 1] != '/') deepest = std::max(deepest, ++depth);
+      if (deepest > limit) return deepest;
+    } else {
+      junkNode(src, xml, i);
     }
-    if (xml.compare(i, 9, "<![CDATA[") == 0) {
-      const auto end = xml.find("]]>", i + 9);
-      if (end == std::string::npos) break;
-      i = end + 2;
-      continue;
-    }
-    if (i + 1 < n && (xml[i + 1] == '?' || xml[i + 1] == '!')) continue;
-    const bool closing = i + 1 < n && xml[i + 1] == '/';
-    // Find the end of the tag, skipping quoted attribute values.
-    std::size_t j = i + 1;
-    char quote = 0;
-    for (; j < n; ++j) {
-      const char c = xml[j];
-      if (quote) {
-        if (c == quote) quote = 0;
-      } else if (c == '"' || c == '\'') {
-        quote = c;
-      } else if (c == '>') {
-        break;
-      }
-    }
-    if (j >= n) break;
-    if (closing) --depth;
-    else if (xml[j - 1] != '/') deepest = std::max(deepest, ++depth);
-    if (deepest > limit) return deepest;
-    i = j;
+    if (end == std::string::npos) break;  // unterminated: the parser's error
+    i = end;
   }
   return deepest;
 }
@@ -93,7 +135,7 @@ void rejectXacro(const XmlSource& src, const TiXmlElement* robot) {
 const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
                                   const std::string& xml) {
   constexpr int kMaxDepth = 256;  // a URDF is 3–4 levels deep
-  if (nestingDepth(xml, kMaxDepth) > kMaxDepth)
+  if (nestingDepth(src, xml, kMaxDepth) > kMaxDepth)
     fail(src, "malformed XML: elements nested more than " + std::to_string(kMaxDepth) +
                   " deep (a URDF needs 4)");
   // TinyXML may look one byte past a truncated UTF-8 sequence at the very

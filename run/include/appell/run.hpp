@@ -59,9 +59,11 @@ struct RunOptions {
   /// Divergence watch on the work balance of every scene,
   ///     E + impact losses + friction work − joint work − support work = E₀
   /// (passive scenes: no work put in, E + losses is conserved): a step after
-  /// which the balance is off by more than this fraction of the energy scale
-  /// (the largest of |E₀|, T₀, |E|, and the work put in so far) stops the run
-  /// as failed, the state kept the last one within the bound. ∞ switches it off.
+  /// which the balance is off by more than this fraction of the energy that
+  /// moved (DivergenceWatch: the largest kinetic energy, potential energy
+  /// exchanged and work so far — none depends on the potential's datum)
+  /// stops the run as failed, the state kept the last one within the bound.
+  /// ∞ switches it off.
   double max_energy_error = 5e-2;
   /// Residual watch: a step after which max(‖A v + b‖∞, max |gap|) exceeds
   /// this stops the run as failed, the state kept the last one within it —
@@ -146,7 +148,7 @@ struct RunSummary {
   double joint_work = 0;           ///< work of the joint forces, ∫ τ·v dt (J)
   double support_work = 0;         ///< work of constraints that move in time, ∫ −λᵀb dt (J)
   std::vector<RunEvent> events;    ///< contact events, in time order
-  double energy_scale = 0;         ///< max(|E₀|, T₀, 1e-12), raised by |E| and the work put in as the run goes
+  double energy_scale = 0;         ///< DivergenceWatch::scale(): the energy that moved (J, ≥ 1e-12)
   double max_velocity_residual = 0;  ///< max ‖A v + b‖∞, t = 0 included
   double max_gap_residual = 0;       ///< max |g|, t = 0 included
   int max_redundant = 0;           ///< most redundant rows at any sample
