@@ -244,9 +244,11 @@ def sweep(scene, parameters=None, *, samples=None, seed=None, cases=None, analys
                 dt, integrator, …) or "linearize" (``appell.linearize``'s:
                 cyclic, formulation, …) at each case's initial state
     executor    "serial", "threads", "processes", "dask" (a LocalCluster of
-                ``workers`` processes on 127.0.0.1, closed at the end) or a
+                ``workers`` processes on 127.0.0.1, closed at the end), a
                 ``distributed.Client`` (its cluster: local or a scheduler's
-                address for many machines)
+                address for many machines), or a ``concurrent.futures``
+                pool — a Client or a pool kept for many sweeps starts its
+                workers, and loads the scene in them, once
     workers     threads or processes (default: the cores; a Client's own
                 worker threads)
     batch_size  cases per task (default: about four tasks per worker)
@@ -265,7 +267,10 @@ def sweep(scene, parameters=None, *, samples=None, seed=None, cases=None, analys
         for c in cases:
             names += [n for n, _ in c if n not in names]
     load_options = dict(load_options or {})
-    remote = not (isinstance(executor, str) and executor in ("serial", "threads"))
+    import concurrent.futures as cf
+
+    remote = not ((isinstance(executor, str) and executor in ("serial", "threads"))
+                  or isinstance(executor, cf.ThreadPoolExecutor))
     if remote and isinstance(scene, _appell.Scene):
         raise ValueError("processes and Dask workers load the scene themselves: give its path "
                          "(and load_options), not a loaded Scene")
@@ -332,6 +337,10 @@ def _execute(scene, load_options, analysis, options, cases, executor, workers, b
     if hasattr(executor, "submit") and hasattr(executor, "gather"):  # a distributed.Client
         threads = sum(executor.nthreads().values()) or 1
         return _on_client(executor, args, cases, workers or threads, batch_size), f"dask {executor.scheduler.address}"
+    if hasattr(executor, "submit"):  # a concurrent.futures pool the caller keeps for many sweeps
+        workers = workers or getattr(executor, "_max_workers", None) or os.cpu_count() or 1
+        futures = [executor.submit(_run_batch, *args, b) for b in _batches(cases, workers, batch_size)]
+        return _collect(n, [f.result() for f in futures]), f"{type(executor).__name__} of {workers}"
     raise ValueError(f"executor must be 'serial', 'threads', 'processes', 'dask' or a distributed.Client, "
                      f"not {executor!r}")
 

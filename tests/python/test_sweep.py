@@ -52,6 +52,20 @@ def test_grid_equals_the_cases_run_one_by_one_bit_for_bit(executor):
         assert scene.v0[3] == dict(case)["speed"]
 
 
+def test_a_process_pool_kept_for_many_sweeps_gives_the_serial_numbers():
+    import concurrent.futures
+    import multiprocessing
+
+    cases = list(appell.grid_cases(GRID))
+    with concurrent.futures.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        first = appell.sweep(DISK, cases=cases[:3], executor=pool, **RUN)
+        second = appell.sweep(DISK, cases=cases[3:], executor=pool, **RUN)
+    assert first.executor == "ProcessPoolExecutor of 2"
+    runs = serial_runs(cases)
+    assert_equal_to_serial(first, runs[:3])
+    assert_equal_to_serial(second, runs[3:])
+
+
 def test_a_dask_local_cluster_of_two_workers_on_loopback_gives_the_serial_numbers():
     distributed = pytest.importorskip("distributed")  # python3-distributed (scripts/install-deps.sh)
     cases = list(appell.grid_cases(GRID))
