@@ -5,6 +5,9 @@ draws are reproducible from their seed and stay in their laws' support; a
 misspelt parameter is an error before anything runs.
 """
 
+import os
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -138,3 +141,24 @@ def test_the_table_writes_to_csv_at_full_precision(tmp_path):
     row = lines[2].split(",")
     assert float(row[header.index("q:root_joint.x")]) == result["q"][1, 0]
     assert float(row[header.index("friction_work")]) == result["friction_work"][1]
+
+
+@pytest.mark.skipif(not os.environ.get("APPELL_CLI"), reason="APPELL_CLI (set by ctest) names the CLI")
+def test_a_cli_run_sweep_row_is_the_same_run_as_the_python_sweeps():
+    # `appell run --sweep` applies the same override rules (run/src/overrides.cpp)
+    # to the same runner: its CSV (%.17g) reads back the Python sweep's doubles.
+    out = subprocess.run([os.environ["APPELL_CLI"], "run", str(DISK), "--sweep", "speed=1:2:3", "--format", "csv",
+                          "--duration", "0.3", "--integrator", "rk4", "--dt", "2e-3"],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    header = lines[0].split(",")
+    result = appell.sweep(DISK, {"speed": [1.0, 1.5, 2.0]}, **RUN)
+    scene = appell.load_scene(DISK)
+    for k, line in enumerate(lines[1:]):
+        row = line.split(",")
+        assert row[header.index("status")] == "ok"
+        q = [float(row[header.index("q:" + n)]) for n in scene.position_names]
+        v = [float(row[header.index("v:" + n)]) for n in scene.velocity_names]
+        assert np.array_equal(q, result["q"][k]) and np.array_equal(v, result["v"][k]), k
+        assert float(row[header.index("energy_error")]) == result["max_energy_deviation"][k]
