@@ -20,10 +20,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 runs = appell.sweep(ROOT / "examples/rolling_disk/rolling_disk.urdf", {"speed": np.linspace(1.0, 3.0, 8)},
                     executor="threads", workers=2, duration=1.0)
 print(runs)
-lean_rate = runs["v"][:, 0]  # ω_x of the floating base, in the disk's frame
-print(f"{'speed':>6} {'status':>7} {'x (m)':>8} {'|ΔE| (J)':>10} {'residual':>10}")
+print(f"{'speed':>6} {'status':>7} {'x (m)':>8} {'y (m)':>8} {'|ΔE| (J)':>10} {'residual':>10}")
 for k in range(len(runs)):
-    print(f"{runs['speed'][k]:6.3f} {runs['status'][k]:>7} {runs['q'][k, 0]:8.4f} "
+    print(f"{runs['speed'][k]:6.3f} {runs['status'][k]:>7} {runs['q'][k, 0]:8.4f} {runs['q'][k, 1]:8.4f} "
           f"{runs['max_energy_deviation'][k]:10.2e} {runs['max_velocity_residual'][k]:10.2e}")
 assert runs.ok.all()
 
