@@ -61,4 +61,9 @@ class CMakeBuild(build_ext):
         subprocess.run(args, check=True)
 
 
-setup(ext_modules=[CMakeExtension("appell._appell")], cmdclass={"build_ext": CMakeBuild})
+# setuptools' own build files go to .pip-build, not to build/ — the folder
+# a CMake build of the checkout usually is.
+SCRATCH = ".pip-build"
+os.makedirs(SOURCE / SCRATCH, exist_ok=True)
+setup(ext_modules=[CMakeExtension("appell._appell")], cmdclass={"build_ext": CMakeBuild},
+      options={"build": {"build_base": SCRATCH}, "egg_info": {"egg_base": SCRATCH}})
