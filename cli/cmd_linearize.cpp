@@ -39,8 +39,9 @@ scene's initial state and prints the eigenvalues.
   --fd-step H         finite-difference step in the local coordinates (default 1e-5)
   --set NAME=VALUE    override before linearizing (repeatable): gravity=gx,gy,gz,
                       speed=V (a floating base's forward speed, the other velocities
-                      completed by the constraints), <joint>.position=…,
-                      <joint>.velocity=…, or a coordinate by its CSV name
+                      changed as little as the constraints allow), <joint>.position=…,
+                      <joint>.velocity=…, <joint>.effort=…, <contact>.mu=μ, or a
+                      coordinate by its CSV name
   --sweep NAME=START:STOP:COUNT
                       linearize at COUNT values of a one-number override, on all
                       cores; prints the largest real part per value and the values
@@ -153,7 +154,7 @@ int printOne(const Scene& scene, const Analysis& a, const std::vector<int>& cycl
   return 0;
 }
 
-int sweep(const Scene& base, const std::vector<int>& kept_base, const Args& args,
+int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
           const std::vector<int>& cyclic, Formulation form, const std::string& format) {
   const Sweep sw = parseSweep(args.text("sweep"));
   std::vector<Analysis> out(sw.values.size());
@@ -167,9 +168,10 @@ int sweep(const Scene& base, const std::vector<int>& kept_base, const Args& args
       for (std::size_t k = w; k < sw.values.size(); k += workers) {
         try {
           Scene s = base;
-          std::vector<int> kept = kept_base;
+          OverrideReport kept;
+          kept.kept = kept_base.kept;
           applyOverride(s, sw.name, full(sw.values[k]), kept);
-          completeVelocities(s, kept);
+          completeSetVelocities(s, kept);
           out[k] = analyse(s, args, cyclic, form, false);
         } catch (const std::exception& e) {
           errors[k] = e.what();
@@ -186,9 +188,10 @@ int sweep(const Scene& base, const std::vector<int>& kept_base, const Args& args
   // off by a good part of the step.
   auto unstable = [&](double value) {
     Scene s = base;
-    std::vector<int> kept = kept_base;
+    OverrideReport kept;
+    kept.kept = kept_base.kept;
     applyOverride(s, sw.name, full(value), kept);
-    completeVelocities(s, kept);
+    completeSetVelocities(s, kept);
     const Analysis a = analyse(s, args, cyclic, form, false);
     return std::pair<bool, bool>(a.ok, a.max_real > a.tol);
   };
@@ -277,7 +280,7 @@ int linearize(int argc, char** argv) {
   // Overrides change the state: check it after them, not at load.
   const bool overrides = !args.all("set").empty();
   Scene scene = loadFromArgs(args, !args.has("equilibrium") && !overrides);
-  const std::vector<int> kept = applyOverrides(scene, args);
+  const OverrideReport kept = applyOverrides(scene, args);
   if (overrides && !args.has("equilibrium"))
     checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
   std::vector<int> cyclic;
@@ -298,6 +301,8 @@ int linearize(int argc, char** argv) {
     throw UsageError(e.what());
   }
   if (args.has("sweep")) return sweep(scene, kept, args, cyclic, form, format);
+  if (format == "text")
+    for (const std::string& line : describe(scene, kept)) std::cout << "override     " << line << "\n";
   const Analysis a = analyse(scene, args, cyclic, form, format == "text");
   if (!a.ok && a.message.rfind("the reference", 0) != 0) {  // no equilibrium found
     std::cout << a.message << "\n";

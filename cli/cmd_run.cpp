@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -65,9 +66,12 @@ const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
   --format F          with --sweep: text (default), csv or json at full precision
   --set NAME=VALUE    override the initial state or a parameter (repeatable):
                       gravity=gx,gy,gz, speed=V (a floating base's forward
-                      speed), <joint>.position=…, <joint>.velocity=…, or a
-                      coordinate by its CSV name; velocities set are kept and
-                      the others completed by the constraints (minimum norm)
+                      speed), <joint>.position=…, <joint>.velocity=…,
+                      <joint>.effort=… (constant joint forces), <contact>.mu=μ,
+                      or a coordinate by its CSV name; velocities set are kept
+                      and the others change as little as the constraints
+                      allow; the summary lists each override and every
+                      velocity the constraints changed
 
 Exit status: 0 success, 1 bad input or an output that could not be written,
 130 interrupted (SIGINT: the summary and the trajectory up to the state reached
@@ -151,11 +155,28 @@ void printContacts(std::ostream& out, const RunSummary& r) {
         << open_names << (open > 4 ? ", …" : "") << ")\n";
 }
 
+// A work term as the summary prints it: in full (the shortest text that
+// reads back as the same double), so a balance can be checked from the
+// printout.
+std::string joule(double x) {
+  char buf[40];
+  const auto end = std::to_chars(buf, buf + sizeof buf, x).ptr;
+  return std::string(buf, end) + " J";
+}
+
+// The kinetic energy the impacts took: 0 exactly when no event had an
+// impulse (lift-offs, slips, sticks and piece changes take none; the
+// engine's sum over them is round-off, −1e-32 J and the like).
+double impactLoss(const RunSummary& r) {
+  const bool any_impulse = std::any_of(r.events.begin(), r.events.end(),
+                                       [](const RunEvent& e) { return e.normal_impulse != 0; });
+  return any_impulse ? r.impact_energy_loss : 0.0;
+}
+
 // One line per contact event (at most the first 50, then a count).
 void printEvents(std::ostream& out, const RunSummary& r) {
   if (r.events.empty()) return;
-  out << "contact events (" << r.events.size() << "; impacts took " << std::setprecision(6)
-      << r.impact_energy_loss << " J):\n";
+  out << "contact events (" << r.events.size() << "; impacts took " << joule(impactLoss(r)) << "):\n";
   const std::size_t shown = std::min<std::size_t>(r.events.size(), 50);
   for (std::size_t k = 0; k < shown; ++k) {
     const RunEvent& e = r.events[k];
@@ -173,11 +194,14 @@ void printEvents(std::ostream& out, const RunSummary& r) {
   if (shown < r.events.size()) out << "  … " << r.events.size() - shown << " more\n";
 }
 
-void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
+void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
+                  const std::vector<std::string>& overrides) {
   const RunOptions& o = r.options;
   const SimulatorCounters& c = r.counters;
   const bool adaptive = adaptiveIntegrator(o.integrator);
-  out << std::setprecision(6) << "scene        " << scene.source << "\n"
+  out << std::setprecision(6) << "scene        " << scene.source << "\n";
+  for (const std::string& line : overrides) out << "override     " << line << "\n";
+  out
       << "model        " << scene.model.nbodies << " bodies, nv = " << scene.model.nv << ", "
       << scene.contacts.size() << " contacts, ";
   if (!scene.joint_limits.empty()) out << scene.joint_limits.size() << " joint limits, ";
@@ -194,10 +218,10 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r) {
       << (r.events.empty() ? "" : "+ impact losses ") << (r.friction_work > 0 ? "+ friction work " : "")
       << (r.passive ? "" : "− work in ") << "− E0| = " << r.max_energy_deviation
       << " J (" << r.relativeEnergyDeviation() << " relative)\n";
-  if (!r.passive || r.friction_work > 0 || r.impact_energy_loss > 0)
-    out << "work         joint forces " << r.joint_work << " J, moving supports " << r.support_work
-        << " J in; impacts " << r.impact_energy_loss << " J, friction " << r.friction_work
-        << " J out\n";
+  if (!r.passive || r.friction_work > 0 || impactLoss(r) > 0)
+    out << "work         joint forces " << joule(r.joint_work) << ", moving supports "
+        << joule(r.support_work) << " in; impacts " << joule(impactLoss(r)) << ", friction "
+        << joule(r.friction_work) << " out\n";
   out
       << "residuals    max |Av+b| = " << r.max_velocity_residual
       << ", max |gap| = " << r.max_gap_residual
@@ -276,7 +300,7 @@ class SigintGuard {
 // SIGINT stops the runs in progress after their current step and starts no
 // new one: the table lists every value, the runs not started as "not run",
 // and the exit status is 130.
-int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& args,
+int runSweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
              const RunOptions& options, const std::string& format) {
   const Sweep sw = parseSweep(args.text("sweep"));
   struct Row {
@@ -303,9 +327,10 @@ int runSweep(const Scene& base, const std::vector<int>& kept_base, const Args& a
         rows[k].started = true;
         try {
           Scene s = base;
-          std::vector<int> kept = kept_base;
+          OverrideReport kept;
+          kept.kept = kept_base.kept;
           applyOverride(s, sw.name, number(sw.values[k]), kept);
-          completeVelocities(s, kept);
+          completeSetVelocities(s, kept);
           checkInitialState(s, args.has("project-initial"), LoadOptions().initial_state_tolerance);
           rows[k].summary = runScene(s, stoppable, [&](const Simulator& sim) {
             rows[k].q = sim.q();
@@ -386,7 +411,7 @@ int run(int argc, char** argv) {
   // Overrides change the state: check it after them, not at load.
   const bool overrides = !args.all("set").empty() || args.has("sweep");
   Scene scene = loadFromArgs(args, !overrides);
-  std::vector<int> kept;
+  OverrideReport kept;
   if (overrides) {
     kept = applyOverrides(scene, args);
     if (!args.has("sweep"))
@@ -454,7 +479,7 @@ int run(int argc, char** argv) {
   }
   progress.done();
 
-  printSummary(std::cout, scene, summary);
+  printSummary(std::cout, scene, summary, describe(scene, kept));
   if (summary.free_velocities == 0 && scene.model.nv > 0 && !summary.can_slip)
     std::cerr << "appell run: warning: " << scene.source
               << ": the constraints leave 0 independent velocities — nothing in this scene can move "

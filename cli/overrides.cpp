@@ -1,10 +1,5 @@
-// --set and --sweep (overrides.hpp).
+// --set and --sweep (overrides.hpp): text to numbers, usage errors.
 #include "overrides.hpp"
-
-#include <appell/constraint_set.hpp>
-#include <appell/output.hpp>
-
-#include <Eigen/QR>
 
 #include <algorithm>
 #include <cmath>
@@ -26,7 +21,9 @@ std::vector<double> numbersOf(const std::string& name, const std::string& text) 
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used == 0 || used != item.size() || !std::isfinite(x))
+    // μ may be ∞ (no friction limit); everything else is finite.
+    const bool mu_inf = std::isinf(x) && x > 0 && name.size() > 3 && name.compare(name.size() - 3, 3, ".mu") == 0;
+    if (used == 0 || used != item.size() || (!std::isfinite(x) && !mu_inf))
       throw UsageError("--set " + name + ": '" + item + "' is not a finite number");
     out.push_back(x);
   }
@@ -42,98 +39,31 @@ double oneNumber(const std::string& name, const std::string& text) {
 
 }  // namespace
 
-void completeVelocities(Scene& scene, const std::vector<int>& kept) {
-  const Model& m = scene.model;
-  if (scene.constraints.empty() || kept.empty()) return;
-  Data data(m);
-  ConstraintData cd(m, scene.constraints);
-  evaluateConstraints(m, data, scene.constraints, cd, 0.0, scene.q0, scene.v0);
-  std::vector<int> rows, free;
-  for (int i = 0; i < cd.m; ++i) {
-    const int c = cd.row_constraint[i];
-    const Constraint& con = *scene.constraints[c];
-    // Contacts with clearance are open: only touching ones constrain.
-    if (con.unilateral() && cd.gap[cd.offset[c] + con.unilateralRow()] > 1e-8) continue;
-    rows.push_back(i);
-  }
-  for (int j = 0; j < m.nv; ++j)
-    if (std::find(kept.begin(), kept.end(), j) == kept.end()) free.push_back(j);
-  MatX A(rows.size(), free.size());
-  VecX rhs(rows.size());
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    rhs[k] = -cd.b[rows[k]];
-    for (int j : kept) rhs[k] -= cd.A(rows[k], j) * scene.v0[j];
-    for (std::size_t c = 0; c < free.size(); ++c) A(k, c) = cd.A(rows[k], free[c]);
-  }
-  const VecX x = Eigen::CompleteOrthogonalDecomposition<MatX>(A).solve(rhs);
-  for (std::size_t c = 0; c < free.size(); ++c) scene.v0[free[c]] = x[c];
-  const double residual = rows.empty() ? 0.0 : (A * x - rhs).lpNorm<Eigen::Infinity>();
-  if (residual > 1e-9 * std::max(1.0, scene.v0.lpNorm<Eigen::Infinity>())) {
-    const std::vector<std::string> names = coordinateNames(m, true);
-    std::string set;
-    for (int j : kept) set += (set.empty() ? "" : ", ") + names[j];
-    throw UsageError("--set: the constraints do not allow " + set + " as set (residual " +
-                     std::to_string(residual) + ")");
+void applyOverride(Scene& scene, const std::string& name, const std::string& value, OverrideReport& report) {
+  try {
+    appell::applyOverride(scene, name, numbersOf(name, value), report);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--set ") + e.what());
   }
 }
 
-void applyOverride(Scene& scene, const std::string& name, const std::string& value, std::vector<int>& kept) {
-  Model& m = scene.model;
-  if (name == "gravity") {
-    const std::vector<double> g = numbersOf(name, value);
-    if (g.size() != 3) throw UsageError("--set gravity: needs gx,gy,gz");
-    m.gravity = Vec3(g[0], g[1], g[2]);
-    return;
+void completeSetVelocities(Scene& scene, OverrideReport& report) {
+  try {
+    appell::completeVelocities(scene, report);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--set: ") + e.what());
   }
-  if (name == "speed") {
-    if (m.nbodies == 0 || m.joints[0].type != JointType::Floating)
-      throw UsageError("--set speed: the scene's root is not a floating base (set a velocity by name instead)");
-    const int vx = m.joints[0].idx_v + 3;  // the root's link-frame vx
-    scene.v0[vx] = oneNumber(name, value);
-    kept.push_back(vx);
-    return;
-  }
-  for (const char* part : {".position", ".velocity"}) {
-    const std::string suffix = part;
-    if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
-      continue;
-    const int j = m.jointIndex(name.substr(0, name.size() - suffix.size()));
-    if (j < 0) break;
-    const Joint& joint = m.joints[j];
-    const std::vector<double> x = numbersOf(name, value);
-    const bool pos = suffix == ".position";
-    const int n = pos ? joint.nq : joint.nv;
-    if (static_cast<int>(x.size()) != n)
-      throw UsageError("--set " + name + ": needs " + std::to_string(n) + " numbers, got " +
-                       std::to_string(x.size()));
-    for (int k = 0; k < n; ++k) (pos ? scene.q0[joint.idx_q + k] : scene.v0[joint.idx_v + k]) = x[k];
-    if (!pos)
-      for (int k = 0; k < n; ++k) kept.push_back(joint.idx_v + k);
-    return;
-  }
-  const std::vector<std::string> q = coordinateNames(m, false), v = coordinateNames(m, true);
-  if (auto it = std::find(q.begin(), q.end(), name); it != q.end()) {
-    scene.q0[it - q.begin()] = oneNumber(name, value);
-    return;
-  }
-  if (auto it = std::find(v.begin(), v.end(), name); it != v.end()) {
-    scene.v0[it - v.begin()] = oneNumber(name, value);
-    kept.push_back(static_cast<int>(it - v.begin()));
-    return;
-  }
-  throw UsageError("--set " + name + ": not gravity, speed, <joint>.position, <joint>.velocity or a "
-                   "coordinate's name as the CSV's q: and v: columns give it");
 }
 
-std::vector<int> applyOverrides(Scene& scene, const Args& args) {
-  std::vector<int> kept;
+OverrideReport applyOverrides(Scene& scene, const Args& args) {
+  OverrideReport report;
   for (const std::string& s : args.all("set")) {
     const auto eq = s.find('=');
     if (eq == std::string::npos || eq == 0) throw UsageError("--set expects NAME=VALUE, got '" + s + "'");
-    applyOverride(scene, s.substr(0, eq), s.substr(eq + 1), kept);
+    applyOverride(scene, s.substr(0, eq), s.substr(eq + 1), report);
   }
-  completeVelocities(scene, kept);
-  return kept;
+  completeSetVelocities(scene, report);
+  return report;
 }
 
 Sweep parseSweep(const std::string& spec) {

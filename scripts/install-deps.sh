@@ -15,6 +15,8 @@ PACKAGES=(
   gnuplot-nox            # figures of the benchmark reports
   python3-dev pybind11-dev        # the Python bindings (python/)
   python3-numpy python3-pytest    # their arrays and their tests
+  python3-pip python3-venv python3-setuptools python3-wheel  # pip install . (pyproject.toml)
+  python3-distributed             # appell.sweep on a Dask cluster (python/appell/sweep.py)
 )
 
 bash "$(dirname "$0")/apt-install.sh" install-deps "${PACKAGES[@]}"

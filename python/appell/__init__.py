@@ -14,6 +14,9 @@ equilibria and linearizations. docs/python.md documents the API.
 ``Simulation.step``, ``advance_to`` and ``record`` release the GIL, so
 independent simulations run in parallel on threads (one thread per
 Simulation; using one Simulation from two threads at once raises).
+``run(scene, overrides)`` runs a scene as ``appell run --set`` does, with its
+work terms and events as arrays; ``sweep`` runs many such cases on threads,
+processes or a Dask cluster (python/appell/sweep.py).
 """
 
 from ._appell import (
@@ -22,6 +25,7 @@ from ._appell import (
     LinearizationResult,
     ModelError,
     MultiStartResult,
+    RunResult,
     Scene,
     SceneError,
     Simulation,
@@ -29,6 +33,7 @@ from ._appell import (
     SimulationSettings,
     StepStatus,
     Trajectory,
+    apply_overrides,
     contact_event_kinds,
     find_equilibria,
     find_equilibrium,
@@ -37,7 +42,9 @@ from ._appell import (
     linearize,
     load_scene,
     load_scene_from_string,
+    run,
 )
+from .sweep import SweepResult, grid_cases, random_cases, sweep
 
 __version__ = "0.1.0"
 
@@ -47,6 +54,7 @@ __all__ = [
     "LinearizationResult",
     "ModelError",
     "MultiStartResult",
+    "RunResult",
     "Scene",
     "SceneError",
     "Simulation",
@@ -54,6 +62,8 @@ __all__ = [
     "SimulationSettings",
     "StepStatus",
     "Trajectory",
+    "SweepResult",
+    "apply_overrides",
     "contact_event_kinds",
     "find_equilibria",
     "find_equilibrium",
@@ -62,4 +72,8 @@ __all__ = [
     "linearize",
     "load_scene",
     "load_scene_from_string",
+    "grid_cases",
+    "random_cases",
+    "run",
+    "sweep",
 ]

@@ -17,4 +17,5 @@ PYBIND11_MODULE(_appell, m) {
   appell::python::bindScene(m);
   appell::python::bindSimulation(m);
   appell::python::bindAnalysis(m);
+  appell::python::bindRun(m);
 }

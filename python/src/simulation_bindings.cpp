@@ -289,6 +289,12 @@ void bindSimulation(py::module_& m) {
       .def_property_readonly("potential_energy", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().potentialEnergy(); })
       .def_property_readonly("energy", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().energy(); })
       .def_property_readonly("impact_energy_loss", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().impactEnergyLoss(); })
+      .def_property_readonly("friction_work", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().frictionWork(); },
+                             "Energy taken by sliding friction since the state was set (J).")
+      .def_property_readonly("joint_work", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().jointWork(); },
+                             "Work of the joint forces since the state was set, ∫ τ·v dt (J).")
+      .def_property_readonly("support_work", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().supportWork(); },
+                             "Work of constraints that move in time since the state was set, ∫ −λᵀb dt (J).")
       .def_property_readonly("velocity_residual", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().velocityResidual(); },
                              "‖A v + b‖∞ over the closed rows.")
       .def_property_readonly("gap_residual", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().gapResidual(); },

@@ -1,0 +1,109 @@
+#!/usr/bin/env python3
+"""appell.sweep on 2 cores: serial, 2 threads, 2 processes and a 2-worker Dask
+LocalCluster (127.0.0.1), on two workloads — 200 rolling-disk runs (speeds
+1…3 m/s, the scene's dopri5 at tol 1e-10, 2 s each) and 200 linearizations
+of the steadily rolling disk (tests/data/linearize/disk_chain.urdf, spin
+1…6 rad/s). Median wall time of --repeat runs each, the speed-up against
+serial, and the per-case overhead of each executor:
+
+    overhead = (workers × wall − Σ the cases' own wall times) / cases,
+
+the time a worker spends per case on anything but the case (shipping,
+scheduling, gathering, idling at the end). The process pool and the
+cluster start once (their start-up printed apart) and run a two-case
+warm-up that loads the scene in each worker, as a user running many sweeps
+keeps them. Each sweep is checked equal to
+the serial one bit for bit. Not a test: the figures depend on the machine
+and its load (bench/RESULTS.md records runs with `uptime`).
+
+    PYTHONPATH=build/python /usr/bin/python3 python/bench/sweep_scaling.py
+"""
+
+import argparse
+import concurrent.futures
+import contextlib
+import multiprocessing
+import os
+import pathlib
+import statistics
+import time
+
+import numpy as np
+
+import appell
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+DISK = ROOT / "examples/rolling_disk/rolling_disk.urdf"
+CHAIN = ROOT / "tests/data/linearize/disk_chain.urdf"
+
+
+def workloads(cases):
+    return {
+        "disk runs": dict(scene=DISK, parameters={"speed": np.linspace(1.0, 3.0, cases)}, duration=2.0),
+        "disk linearizations": dict(scene=CHAIN, parameters={"spin.velocity": np.linspace(1.0, 6.0, cases)},
+                                    analysis="linearize", cyclic=["plane.x", "plane.y", "plane.theta", "spin"]),
+    }
+
+
+def same(a, b):
+    keys = ("q", "v", "eigenvalues", "max_energy_deviation", "friction_work", "max_real")
+    return all(np.array_equal(a[k], b[k], equal_nan=True) for k in keys if k in a)
+
+
+def measure(work, executor, workers, repeat, reference):
+    walls, overheads = [], []
+    appell.sweep(**dict(work, parameters={k: v[: 4 * workers] for k, v in work["parameters"].items()}),
+                 executor=executor, workers=workers)  # warm-up: the workers load the scene
+    for _ in range(repeat):
+        start = time.perf_counter()
+        r = appell.sweep(executor=executor, workers=workers, **work)
+        wall = time.perf_counter() - start
+        n = 1 if executor == "serial" else workers
+        walls.append(wall)
+        overheads.append((n * wall - r["wall_seconds"].sum()) / len(r))
+        if reference is not None and not same(r, reference):
+            raise SystemExit(f"{executor}: results differ from the serial sweep")
+    return statistics.median(walls), statistics.median(overheads), r
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cases", type=int, default=200)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--executors", default="serial,threads,processes,dask")
+    args = ap.parse_args()
+    print(f"load average before: {os.getloadavg()}")
+    # Pools and the cluster start once, as a user running many sweeps keeps
+    # them; their start-up is reported apart.
+    pools = {"serial": "serial", "threads": "threads"}
+    names = args.executors.split(",")
+    with contextlib.ExitStack() as stack:
+        if "processes" in names:
+            start = time.perf_counter()
+            pools["processes"] = stack.enter_context(concurrent.futures.ProcessPoolExecutor(
+                args.workers, mp_context=multiprocessing.get_context("spawn")))
+            print(f"process pool: {time.perf_counter() - start:.2f} s to start")
+        if "dask" in names:
+            from distributed import Client, LocalCluster
+
+            start = time.perf_counter()
+            cluster = stack.enter_context(LocalCluster(n_workers=args.workers, threads_per_worker=1,
+                                                       host="127.0.0.1", dashboard_address=None))
+            pools["dask"] = stack.enter_context(Client(cluster))
+            print(f"dask LocalCluster of {args.workers} workers: {time.perf_counter() - start:.2f} s to start")
+        for name, work in workloads(args.cases).items():
+            print(f"\n{name}: {args.cases} cases, median of {args.repeat}")
+            print(f"{'executor':>10} {'wall (s)':>9} {'speed-up':>9} {'overhead/case (ms)':>19}")
+            serial, reference = None, None
+            for executor in names:
+                wall, overhead, r = measure(work, pools[executor], args.workers, args.repeat, reference)
+                if executor == "serial":
+                    serial, reference = wall, r
+                speedup = f"{serial / wall:8.2f}×" if serial else "        -"
+                print(f"{executor:>10} {wall:9.3f} {speedup} {1e3 * overhead:19.3f}", flush=True)
+    print(f"\nload average after: {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()

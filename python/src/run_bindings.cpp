@@ -1,0 +1,262 @@
+// A whole run and named overrides, as `appell run --set …` does them:
+//   apply_overrides(scene, overrides) → (a new Scene, the lines saying what
+//     changed) — run/include/appell/overrides.hpp's names and rules;
+//   run(scene, …) → RunResult: runScene (run.hpp) with the GIL released —
+//     how it ended, the work terms of the energy balance
+//       E(t) + impact losses + friction work − joint work − support work = E₀,
+//     the residuals, the final state, and every contact event with the states
+//     around it, as NumPy arrays.
+// Sweeps (python/appell/sweep.py) are made of these two calls.
+#include "bindings.hpp"
+
+#include <appell/contact_events.hpp>
+#include <appell/overrides.hpp>
+#include <appell/run.hpp>
+#include <appell/urdf.hpp>
+
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <map>
+#include <optional>
+
+namespace appell::python {
+
+using namespace pybind11::literals;
+
+namespace {
+
+/// A run's summary, its final state and its events with the states around them.
+struct RunResult {
+  RunSummary summary;
+  VecX q, v;
+  double energy = 0, kinetic = 0;
+  /// Per event: the last state the run passed before it (the start of the
+  /// step the event ended, at t_before) and the state at the event, after
+  /// its impulse (the end of that step).
+  std::vector<double> t_before;
+  std::vector<VecX> q_before, v_before, q_after, v_after;
+  int nq = 0, nv = 0;
+  std::vector<std::string> overrides;
+};
+
+MatX rows(const std::vector<VecX>& x, int n) {
+  MatX out(x.size(), n);
+  for (std::size_t k = 0; k < x.size(); ++k) out.row(k) = x[k].transpose();
+  return out;
+}
+
+/// The scene with `overrides` (name → number or sequence, in order) applied
+/// and its velocities completed; `describe`'s lines.
+std::pair<std::shared_ptr<Scene>, std::vector<std::string>> withOverrides(const Scene& base, py::handle overrides,
+                                                                         OverrideReport* report_out = nullptr) {
+  auto scene = std::make_shared<Scene>(base);
+  OverrideReport report;
+  if (!overrides.is_none()) {
+    py::object items = py::isinstance<py::dict>(overrides) ? overrides.attr("items")() : py::reinterpret_borrow<py::object>(overrides);
+    for (py::handle item : items) {
+      auto pair = item.cast<py::tuple>();
+      if (pair.size() != 2) throw py::value_error("an override is a (name, value) pair");
+      const std::string name = pair[0].cast<std::string>();
+      std::vector<double> values;
+      if (py::isinstance<py::str>(pair[1]))
+        throw py::value_error(name + ": give a number or a sequence of numbers, not a string");
+      if (py::hasattr(pair[1], "__len__"))
+        values = pair[1].cast<std::vector<double>>();
+      else
+        values.push_back(pair[1].cast<double>());
+      applyOverride(*scene, name, values, report);
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    completeVelocities(*scene, report);
+  }
+  if (report_out) *report_out = report;
+  return {scene, describe(*scene, report)};
+}
+
+RunOptions options(const Scene& s, std::optional<double> duration, std::optional<double> dt,
+                   std::optional<double> tol, std::optional<std::string> integrator,
+                   std::optional<std::string> formulation, double max_energy_error, double max_residual,
+                   double settle_time, bool project) {
+  SimulationSettings settings = s.settings;
+  if (duration) settings.duration = *duration;
+  if (dt) settings.dt = *dt;
+  if (tol) settings.tol = *tol;
+  if (integrator) settings.integrator = *integrator;
+  if (formulation) settings.formulation = *formulation;
+  RunOptions o = runOptions(settings);
+  o.max_energy_error = max_energy_error;
+  o.max_residual = max_residual;
+  if (!(settle_time >= 0) || !std::isfinite(settle_time))
+    throw std::invalid_argument("settle_time must be a finite number ≥ 0, not " + std::to_string(settle_time));
+  o.settle_time = settle_time;
+  o.project_positions = o.project_velocities = project;
+  o.output_every = 1 << 30;  // only the first and last states are sampled
+  return o;
+}
+
+/// runScene, keeping the final state and the states around each event.
+RunResult runWithEvents(const Scene& scene, const RunOptions& o) {
+  RunResult r;
+  double t_prev = 0;
+  VecX q_prev = scene.q0, v_prev = scene.v0;  // sized once: assignments reuse them
+  auto on_step = [&](const Simulator& sim) {
+    for (std::size_t k = 0; k < sim.events().size(); ++k) {
+      r.t_before.push_back(t_prev);
+      r.q_before.push_back(q_prev);
+      r.v_before.push_back(v_prev);
+      r.q_after.push_back(sim.q());
+      r.v_after.push_back(sim.v());
+    }
+    t_prev = sim.time();
+    q_prev = sim.q();
+    v_prev = sim.v();
+  };
+  bool first = true;
+  auto on_sample = [&](const Simulator& sim) {
+    if (first) {  // t = 0: events of the initial state (a contact opening at once)
+      for (std::size_t k = 0; k < sim.events().size(); ++k) {
+        r.t_before.push_back(0);
+        r.q_before.push_back(scene.q0);
+        r.v_before.push_back(scene.v0);
+        r.q_after.push_back(sim.q());
+        r.v_after.push_back(sim.v());
+      }
+      t_prev = sim.time();
+      q_prev = sim.q();
+      v_prev = sim.v();
+      first = false;
+    }
+    r.q = sim.q();
+    r.v = sim.v();
+    r.energy = sim.energy();
+    r.kinetic = sim.kineticEnergy();
+  };
+  r.summary = runScene(scene, o, on_sample, on_step);
+  r.nq = scene.model.nq;
+  r.nv = scene.model.nv;
+  return r;
+}
+
+py::dict eventTable(const RunResult& r) {
+  const auto& ev = r.summary.events;
+  const std::size_t n = ev.size();
+  VecX t(n), sb(n), sa(n), ni(n), ti(n);
+  std::vector<std::string> names, kinds;
+  std::vector<bool> outside;
+  for (std::size_t k = 0; k < n; ++k) {
+    t[k] = ev[k].t;
+    sb[k] = ev[k].speed_before;
+    sa[k] = ev[k].speed_after;
+    ni[k] = ev[k].normal_impulse;
+    ti[k] = ev[k].tangential_impulse;
+    names.push_back(ev[k].contact);
+    kinds.push_back(toString(ev[k].kind));
+    outside.push_back(ev[k].outside_friction_cone);
+  }
+  py::dict d;
+  d["t"] = t;
+  d["contact"] = names;
+  d["kind"] = kinds;
+  d["speed_before"] = sb;
+  d["speed_after"] = sa;
+  d["normal_impulse"] = ni;
+  d["tangential_impulse"] = ti;
+  d["outside_friction_cone"] = outside;
+  d["t_before"] = Eigen::Map<const VecX>(r.t_before.data(), static_cast<Eigen::Index>(r.t_before.size())).eval();
+  d["q_before"] = rows(r.q_before, r.nq);
+  d["v_before"] = rows(r.v_before, r.nv);
+  d["q_after"] = rows(r.q_after, r.nq);
+  d["v_after"] = rows(r.v_after, r.nv);
+  return d;
+}
+
+void bindRunResult(py::module_& m) {
+  py::class_<RunResult>(m, "RunResult",
+                        "A run's summary (run.hpp RunSummary), final state, work terms and events.")
+      .def_property_readonly("ok", [](const RunResult& r) { return r.summary.ok; })
+      .def_property_readonly("failure", [](const RunResult& r) { return r.summary.failure; })
+      .def_property_readonly("time", [](const RunResult& r) { return r.summary.time; })
+      .def_readonly("q", &RunResult::q)
+      .def_readonly("v", &RunResult::v)
+      .def_readonly("energy", &RunResult::energy, "E at the end (J)")
+      .def_readonly("kinetic_energy", &RunResult::kinetic)
+      .def_property_readonly("energy0", [](const RunResult& r) { return r.summary.energy0; })
+      .def_property_readonly("impact_energy_loss", [](const RunResult& r) { return r.summary.impact_energy_loss; })
+      .def_property_readonly("friction_work", [](const RunResult& r) { return r.summary.friction_work; })
+      .def_property_readonly("joint_work", [](const RunResult& r) { return r.summary.joint_work; })
+      .def_property_readonly("support_work", [](const RunResult& r) { return r.summary.support_work; })
+      .def_property_readonly("passive", [](const RunResult& r) { return r.summary.passive; })
+      .def_property_readonly("max_energy_deviation", [](const RunResult& r) { return r.summary.max_energy_deviation; })
+      .def_property_readonly("relative_energy_deviation",
+                             [](const RunResult& r) { return r.summary.relativeEnergyDeviation(); })
+      .def_property_readonly("max_velocity_residual", [](const RunResult& r) { return r.summary.max_velocity_residual; })
+      .def_property_readonly("max_gap_residual", [](const RunResult& r) { return r.summary.max_gap_residual; })
+      .def_property_readonly("wall_seconds", [](const RunResult& r) { return r.summary.wall_seconds; })
+      .def_property_readonly("steps", [](const RunResult& r) { return r.summary.counters.steps; })
+      .def_property_readonly("rejected", [](const RunResult& r) { return r.summary.counters.rejected; })
+      .def_property_readonly("evaluations", [](const RunResult& r) { return r.summary.counters.evaluations; })
+      .def_property_readonly("partition_changes", [](const RunResult& r) { return r.summary.partition_changes; })
+      .def_readonly("overrides", &RunResult::overrides, "What the overrides set and what they changed.")
+      .def_property_readonly("event_counts", [](const RunResult& r) {
+        std::map<std::string, int> counts;
+        for (const auto& k : contactEventKindTable()) counts[k.name] = 0;
+        for (const RunEvent& e : r.summary.events) ++counts[toString(e.kind)];
+        return counts;
+      }, "Number of events of each kind (every kind present, 0 when none).")
+      .def_property_readonly("events", &eventTable,
+                             "The contact events as arrays, one entry per event: t, contact, kind, "
+                             "speed_before, speed_after, normal_impulse, tangential_impulse, "
+                             "outside_friction_cone, and the states around it — q_before, v_before "
+                             "at t_before (the last state the run passed before it) and q_after, "
+                             "v_after (at the event, after its impulse).")
+      .def("__bool__", [](const RunResult& r) { return r.summary.ok; })
+      .def("__repr__", [](const RunResult& r) {
+        return "<RunResult: " + std::string(r.summary.ok ? "ok" : "failed: " + r.summary.failure) +
+               ", t = " + std::to_string(r.summary.time) + ">";
+      });
+}
+
+}  // namespace
+
+void bindRun(py::module_& m) {
+  bindRunResult(m);
+  m.def("apply_overrides", [](const Scene& s, py::handle overrides, bool check_initial_state, bool project,
+                              double tol) {
+        auto [scene, lines] = withOverrides(s, overrides);
+        if (check_initial_state) {
+          py::gil_scoped_release release;
+          checkInitialState(*scene, project, tol);
+        }
+        return py::make_tuple(scene, lines);
+      }, "scene"_a, "overrides"_a, py::kw_only(), "check_initial_state"_a = true, "project"_a = false,
+      "tol"_a = 1e-8,
+      "A copy of the scene with overrides applied, as `appell run --set` does (docs/python.md), and "
+      "the lines saying what they set and which velocities the constraints changed.");
+  m.def("run", [](const Scene& s, py::handle overrides, std::optional<double> duration, std::optional<double> dt,
+                  std::optional<double> tol, std::optional<std::string> integrator,
+                  std::optional<std::string> formulation, double max_energy_error, double max_residual,
+                  double settle_time, bool project, bool project_initial) {
+        auto [scene, lines] = withOverrides(s, overrides);
+        const RunOptions o = options(*scene, duration, dt, tol, integrator, formulation, max_energy_error,
+                                     max_residual, settle_time, project);
+        RunResult r;
+        const bool check = !overrides.is_none();  // the loader checked the scene's own state
+        {
+          py::gil_scoped_release release;
+          if (check) checkInitialState(*scene, project_initial, LoadOptions().initial_state_tolerance);
+          r = runWithEvents(*scene, o);
+        }
+        r.overrides = lines;
+        return r;
+      }, "scene"_a, "overrides"_a = py::none(), py::kw_only(), "duration"_a = py::none(), "dt"_a = py::none(),
+      "tol"_a = py::none(), "integrator"_a = py::none(), "formulation"_a = py::none(),
+      "max_energy_error"_a = 5e-2, "max_residual"_a = 1e-6, "settle_time"_a = ContactEventOptions{}.settle_time,
+      "project"_a = true, "project_initial"_a = false,
+      "Runs the scene as `appell run` does (the GIL released) and returns a RunResult.");
+}
+
+}  // namespace appell::python

@@ -1,0 +1,164 @@
+"""appell.sweep: every executor gives the numbers of the same cases run one by
+one (appell.run / appell.linearize of the overridden scene) bit for bit; a
+Dask LocalCluster of two worker processes on 127.0.0.1 included. Random
+draws are reproducible from their seed and stay in their laws' support; a
+misspelt parameter is an error before anything runs.
+"""
+
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import appell
+from conftest import example, SOURCE_DIR
+
+DISK = example("rolling_disk/rolling_disk.urdf")
+CHAIN = SOURCE_DIR / "tests/data/linearize/disk_chain.urdf"
+CYCLIC = ["plane.x", "plane.y", "plane.theta", "spin"]
+# Short RK4 runs: the cases differ in speed and in gravity's strength.
+RUN = dict(duration=0.3, integrator="rk4", dt=2e-3)
+GRID = {"speed": [1.0, 1.5, 2.25], "gravity": [(0, 0, -9.81), (0, 0, -1.62)]}
+
+RUN_COLUMNS = ["time", "energy0", "energy", "impact_energy_loss", "friction_work", "joint_work",
+               "support_work", "max_energy_deviation", "max_velocity_residual", "max_gap_residual"]
+
+
+def serial_runs(cases):
+    scene = appell.load_scene(DISK)
+    return [appell.run(scene, case, **RUN) for case in cases]
+
+
+def assert_equal_to_serial(result, runs):
+    assert list(result["status"]) == ["ok"] * len(runs)
+    for k, r in enumerate(runs):
+        assert np.array_equal(result["q"][k], r.q) and np.array_equal(result["v"][k], r.v), k
+        for name in RUN_COLUMNS:
+            assert result[name][k] == getattr(r, name), (k, name)
+        assert result["steps"][k] == r.steps
+        assert result["events"][k] == sum(r.event_counts.values())
+
+
+@pytest.mark.parametrize("executor", ["serial", "threads", "processes"])
+def test_grid_equals_the_cases_run_one_by_one_bit_for_bit(executor):
+    result = appell.sweep(DISK, GRID, executor=executor, workers=2, batch_size=2, **RUN)
+    assert len(result) == 6 and result.parameters == ["speed", "gravity"]
+    # The grid's order: the last name varies fastest.
+    assert list(result.cases[1]) == [("speed", 1.0), ("gravity", (0, 0, -1.62))]
+    assert np.array_equal(result["speed"], [1.0, 1.0, 1.5, 1.5, 2.25, 2.25])
+    assert result["gravity"].shape == (6, 3)
+    assert_equal_to_serial(result, serial_runs(result.cases))
+    # Each case did what it says: the disk starts at its speed (body-frame vx).
+    for k, case in enumerate(result.cases):
+        scene, _ = appell.apply_overrides(appell.load_scene(DISK), case)
+        assert scene.v0[3] == dict(case)["speed"]
+
+
+def test_a_process_pool_kept_for_many_sweeps_gives_the_serial_numbers():
+    import concurrent.futures
+    import multiprocessing
+
+    cases = list(appell.grid_cases(GRID))
+    with concurrent.futures.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        first = appell.sweep(DISK, cases=cases[:3], executor=pool, **RUN)
+        second = appell.sweep(DISK, cases=cases[3:], executor=pool, **RUN)
+    assert first.executor == "ProcessPoolExecutor of 2"
+    runs = serial_runs(cases)
+    assert_equal_to_serial(first, runs[:3])
+    assert_equal_to_serial(second, runs[3:])
+
+
+def test_a_dask_local_cluster_of_two_workers_on_loopback_gives_the_serial_numbers():
+    distributed = pytest.importorskip("distributed")  # python3-distributed (scripts/install-deps.sh)
+    cases = list(appell.grid_cases(GRID))
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        assert all(addr.startswith("tcp://127.0.0.1:") for addr in client.scheduler_info()["workers"])
+        result = appell.sweep(DISK, cases=cases, executor=client, batch_size=2, **RUN)
+        # Three batches of two cases: the work went to both workers' processes.
+        assert "dask tcp://127.0.0.1:" in result.executor
+    assert_equal_to_serial(result, serial_runs(cases))
+
+
+def test_executor_dask_makes_its_own_loopback_cluster():
+    pytest.importorskip("distributed")
+    cases = list(appell.grid_cases({"speed": [1.0, 2.0]}))
+    result = appell.sweep(DISK, cases=cases, executor="dask", workers=2, **RUN)
+    assert result.executor == "dask LocalCluster of 2 workers"
+    assert_equal_to_serial(result, serial_runs(cases))
+
+
+def test_linearize_sweep_equals_linearize_of_each_overridden_scene():
+    spins = np.linspace(1.0, 6.0, 6)
+    result = appell.sweep(CHAIN, {"spin.velocity": spins}, analysis="linearize", executor="threads",
+                          workers=2, cyclic=CYCLIC)
+    base = appell.load_scene(CHAIN)
+    for k, spin in enumerate(spins):
+        scene, lines = appell.apply_overrides(base, [("spin.velocity", spin)])
+        lin = appell.linearize(scene, cyclic=CYCLIC)
+        eig = np.asarray(lin.eigenvalues)
+        assert np.array_equal(result["eigenvalues"][k, : eig.size], eig)
+        assert result["max_real"][k] == eig.real.max()
+        assert result["dimension"][k] == lin.dimension
+    # The upright disk is stable above a critical spin and unstable below it
+    # (docs/equilibria.md: sqrt(g / (3 r)) for the thin disk of radius 0.3).
+    critical = np.sqrt(9.81 / (3 * 0.3))
+    assert all((result["max_real"] > 1e-6) == (spins < critical))
+
+
+def test_random_draws_are_reproducible_from_their_seed_and_inside_their_laws():
+    laws = {"speed": (1.0, 3.0), "root_joint.wx": ("normal", 0.5, 0.1)}
+    a = appell.random_cases(laws, 50, seed=7)
+    b = appell.random_cases(laws, 50, seed=7)
+    c = appell.random_cases(laws, 50, seed=8)
+    assert a == b and a != c
+    speeds = np.array([dict(case)["speed"] for case in a])
+    assert speeds.min() >= 1.0 and speeds.max() < 3.0
+    lean = np.array([dict(case)["root_joint.wx"] for case in a])
+    assert abs(lean.mean() - 0.5) < 4 * 0.1 / np.sqrt(50)
+    result = appell.sweep(DISK, laws, samples=4, seed=7, executor="threads", workers=2, **RUN)
+    assert np.array_equal(result["speed"], speeds[:4])  # one stream, drawn name by name
+    assert result.cases == appell.random_cases(laws, 4, seed=7)
+    assert_equal_to_serial(result, serial_runs(result.cases))
+
+
+def test_a_misspelt_parameter_is_an_error_before_anything_runs():
+    with pytest.raises(ValueError, match="wobble: not gravity, speed"):
+        appell.sweep(DISK, {"wobble": [1.0, 2.0]}, executor="threads", **RUN)
+    with pytest.raises(ValueError, match="give its path"):
+        appell.sweep(appell.load_scene(DISK), {"speed": [1.0]}, executor="processes", **RUN)
+
+
+def test_the_table_writes_to_csv_at_full_precision(tmp_path):
+    result = appell.sweep(DISK, {"speed": [1.0, 2.0]}, **RUN)
+    scene = appell.load_scene(DISK)
+    path = tmp_path / "sweep.csv"
+    result.to_csv(path, (scene.position_names, scene.velocity_names))
+    lines = path.read_text().splitlines()
+    header = lines[0].split(",")
+    assert header[:2] == ["speed", "status"] and "q:root_joint.x" in header and "v:root_joint.vx" in header
+    row = lines[2].split(",")
+    assert float(row[header.index("q:root_joint.x")]) == result["q"][1, 0]
+    assert float(row[header.index("friction_work")]) == result["friction_work"][1]
+
+
+@pytest.mark.skipif(not os.environ.get("APPELL_CLI"), reason="APPELL_CLI (set by ctest) names the CLI")
+def test_a_cli_run_sweep_row_is_the_same_run_as_the_python_sweeps():
+    # `appell run --sweep` applies the same override rules (run/src/overrides.cpp)
+    # to the same runner: its CSV (%.17g) reads back the Python sweep's doubles.
+    out = subprocess.run([os.environ["APPELL_CLI"], "run", str(DISK), "--sweep", "speed=1:2:3", "--format", "csv",
+                          "--duration", "0.3", "--integrator", "rk4", "--dt", "2e-3"],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    header = lines[0].split(",")
+    result = appell.sweep(DISK, {"speed": [1.0, 1.5, 2.0]}, **RUN)
+    scene = appell.load_scene(DISK)
+    for k, line in enumerate(lines[1:]):
+        row = line.split(",")
+        assert row[header.index("status")] == "ok"
+        q = [float(row[header.index("q:" + n)]) for n in scene.position_names]
+        v = [float(row[header.index("v:" + n)]) for n in scene.velocity_names]
+        assert np.array_equal(q, result["q"][k]) and np.array_equal(v, result["v"][k]), k
+        assert float(row[header.index("energy_error")]) == result["max_energy_deviation"][k]
