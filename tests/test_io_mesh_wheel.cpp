@@ -105,6 +105,49 @@ TEST(MeshWheel, FlatTreadFitsADiskAndEccentricityShowsAsDeviation) {
                std::invalid_argument);  // on the axle
 }
 
+namespace {
+
+// A regular N-gon prism about the axle x (radius R, width w), moved by `offset`.
+std::vector<Vec3> prism(int sides, double R, double w, const Vec3& offset = Vec3::Zero()) {
+  std::vector<Vec3> v;
+  for (int s = 0; s < sides; ++s) {
+    const double th = 2 * std::numbers::pi * s / sides;
+    for (double x : {-w / 2, w / 2}) v.push_back(Vec3(x, R * std::cos(th), R * std::sin(th)) + offset);
+  }
+  return v;
+}
+
+}  // namespace
+
+// The wheel rule (wheel_fit.hpp): the runout of a regular N-gon is its chord
+// sag R(1 − cos π/N) exactly; 2 % of R admits 16 sides (1.92 %) and refuses
+// 12 (3.41 %); an axle off centre adds about twice its eccentricity; a boot
+// about its ankle (the corpus's foot) is far out of round.
+TEST(MeshWheel, AWheelIsRoundToTwoPercentOfItsRadius) {
+  const double R = 0.1;
+  for (int n : {12, 16, 24, 48}) {
+    const WheelFit f = fitWheel(prism(n, R, 0.03), Vec3::Zero(), Vec3::UnitX());
+    EXPECT_NEAR(f.runout, R * (1 - std::cos(std::numbers::pi / n)), 1e-15) << n << " sides";
+    EXPECT_EQ(isWheel(f), n >= 16) << n << " sides";
+  }
+  // Off centre by e: the far vertex is at R + e, the nearest edge at
+  // (R − e) cos(π/48) — the runout is the sag plus e (1 + cos π/48) ≈ 2e,
+  // an engineer's total runout. e = 0.5 % of R is a wheel, 1 % is not.
+  const double c48 = std::cos(std::numbers::pi / 48);
+  for (double e : {0.005 * R, 0.01 * R}) {
+    const WheelFit off = fitWheel(prism(48, R, 0.03, Vec3(0, e, 0)), Vec3::Zero(), Vec3::UnitX());
+    EXPECT_NEAR(off.runout, R * (1 - c48) + e * (1 + c48), 1e-15) << e;
+    EXPECT_EQ(isWheel(off), e < 0.01 * R) << e;
+  }
+  // The boot of tests/data/published (make_meshes.py) about its ankle axis y.
+  const std::vector<Vec3> boot = {{-0.08, -0.05, -0.1}, {0.14, -0.05, -0.1}, {0.14, 0.05, -0.1},
+                                  {-0.08, 0.05, -0.1},  {-0.04, -0.04, 0.03}, {0.04, -0.04, 0.03},
+                                  {0.04, 0.04, 0.03},   {-0.04, 0.04, 0.03}};
+  const WheelFit foot = fitWheel(boot, Vec3::Zero(), Vec3::UnitY());
+  EXPECT_GT(foot.runout, 0.5 * foot.outer_radius);
+  EXPECT_FALSE(isWheel(foot));
+}
+
 // A sliding contact on a mesh is not a wheel: it touches with the vertices.
 TEST(MeshWheel, OnlyRollingContactsOnRevoluteJointsAreFitted) {
   std::string xml = meshWheeledDiffDrive();

@@ -201,10 +201,22 @@ TEST(Mimic, MalformedCouplingsAreRefusedWithFileLineAndReason) {
               R"(<mimic joint="right_joint"/></joint>)");
   const std::string e = loadError(xml);
   EXPECT_NE(e.find("come back to it"), std::string::npos) << e;
-  // A fixed joint cannot follow.
-  std::string fixed = gripper("");
-  fixed.replace(fixed.find("</joint>"), 8, R"(<mimic joint="left_joint"/></joint>)");
-  EXPECT_NE(loadError(fixed).find("a fixed joint cannot mimic"), std::string::npos) << loadError(fixed);
+  // Each refusal says what to write instead.
+  EXPECT_NE(loadError(gripper(R"(<mimic joint="palm_joint"/>)")).find("remove the <mimic>"), std::string::npos);
+}
+
+// A <mimic> left on a fixed joint (a CAD export's or a xacro macro's, the
+// joint fixed later) moves nothing: it is ignored with one warning naming
+// the line, as Pinocchio ignores it — no coupling row, the gripper unchanged.
+TEST(Mimic, AMimicOnAFixedJointIsIgnoredWithAWarning) {
+  std::string fixed = gripper(kGripperMimic);
+  fixed.replace(fixed.find("</joint>"), 8, R"(<mimic joint="left_joint" multiplier="2"/></joint>)");
+  const Scene s = loadSceneFromString(fixed, ".", "mimic.urdf");
+  ASSERT_EQ(s.couplings.size(), 1u);  // right_joint's, not palm_joint's
+  EXPECT_EQ(s.couplings[0]->follower(), s.model.jointIndex("right_joint"));
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0], "mimic.urdf:6: <mimic>: a fixed joint moves nothing: its <mimic> of "
+                           "'left_joint' is ignored");
 }
 
 namespace {

@@ -1,3 +1,5 @@
+// The rolling shape of a mesh wheel and its roundness (wheel_fit.hpp states
+// the fit, the runout and the rule).
 #include <appell/wheel_fit.hpp>
 
 #include <Eigen/QR>
@@ -7,6 +9,45 @@
 #include <stdexcept>
 
 namespace appell {
+
+namespace {
+
+using Vec2 = Eigen::Vector2d;  // a point across the axle
+
+double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// R minus the distance from the origin to the nearest edge of the convex hull
+// of `points` (Andrew's monotone chain, counter-clockwise), R when the hull
+// has no area.
+double runoutAbout(std::vector<Vec2> points, double R) {
+  std::sort(points.begin(), points.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  points.erase(std::unique(points.begin(), points.end()), points.end());  // a prism's two rims project alike
+  std::vector<Vec2> hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {  // lower hull
+    while (k >= 2 && cross2(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {  // upper hull
+    while (k >= lower && cross2(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  if (k < 4) return R;  // fewer than 3 distinct corners (k counts the first twice)
+  double nearest = INFINITY;
+  for (std::size_t i = 0; i + 1 < k; ++i) {
+    const Vec2 edge = hull[i + 1] - hull[i];
+    nearest = std::min(nearest, cross2(edge, -hull[i]) / edge.norm());  // < 0: origin outside
+  }
+  return R - nearest;
+}
+
+}  // namespace
+
+bool isWheel(const WheelFit& fit) {
+  const double allowed = kWheelTolerance * fit.outer_radius;
+  return fit.runout <= allowed && (!fit.torus || fit.max_deviation <= allowed);
+}
 
 WheelFit fitWheel(const std::vector<Vec3>& vertices, const Vec3& axle_point, const Vec3& axle) {
   if (vertices.size() < 3) throw std::invalid_argument("a wheel mesh needs at least 3 vertices");
@@ -28,6 +69,15 @@ WheelFit fitWheel(const std::vector<Vec3>& vertices, const Vec3& axle_point, con
   if (!(fit.width > 1e-9 * R))
     throw std::invalid_argument("the wheel mesh is flat across its axle (no width): give an explicit shape");
   const double zc = 0.5 * (zlo + zhi);
+  {
+    const Vec3 u = a.unitOrthogonal(), w = a.cross(u);
+    std::vector<Vec2> across(vertices.size());
+    for (std::size_t k = 0; k < vertices.size(); ++k) {
+      const Vec3 p = vertices[k] - axle_point;
+      across[k] = Vec2(u.dot(p), w.dot(p));
+    }
+    fit.runout = runoutAbout(std::move(across), R);
+  }
 
   // The tread and its circle fit, in coordinates about (z_c, R) scaled by R
   // for conditioning.

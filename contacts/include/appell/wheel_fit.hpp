@@ -16,6 +16,17 @@
 // reports the largest distance of a tread vertex from the fitted surface —
 // chord sag and export noise for a true wheel; eccentricity (a mesh not
 // centred on the axle) or a tread that is not a circle show up there.
+//
+// Whether the mesh is a wheel at all is its roundness about the axle: the
+// runout R − d, with d the distance from the axle to the nearest edge of the
+// convex outline of the vertices projected across the axle (a regular
+// N-gon: R(1 − cos π/N), its chord sag; a wheel off centre by e adds
+// e(1 + cos π/N) ≈ 2e, the total runout of engineering drawings; a foot
+// about its ankle is most of R). isWheel accepts a fit
+// whose runout — and, for a torus, the tread's deviation from its circle —
+// is at most kWheelTolerance = 2 % of R: a 16-gon's sag is 1.9 %, so any
+// wheel tessellated at least that finely passes, while a shape that is not
+// round (an ankle or a sole, tens of % of R) fails by an order of magnitude.
 #pragma once
 
 #include <appell/shapes.hpp>
@@ -33,7 +44,17 @@ struct WheelFit {
   double width = 0;          ///< extent along the axle
   double max_deviation = 0;  ///< largest distance of a tread vertex from the shape
   int tread_vertices = 0;
+  /// R minus the distance from the axle to the nearest edge of the convex
+  /// outline across the axle (≥ R when the axle lies outside the outline).
+  double runout = 0;
 };
+
+/// The largest out-of-roundness a wheel may have, as a fraction of its outer radius.
+inline constexpr double kWheelTolerance = 0.02;
+
+/// Whether a fit is a wheel: runout and (torus) tread deviation at most
+/// kWheelTolerance · outer radius.
+bool isWheel(const WheelFit& fit);
 
 /// Fits the rolling shape of `vertices` (link frame) about the axle through
 /// `axle_point` along `axle` (unit). Throws std::invalid_argument when the

@@ -14,7 +14,8 @@
 //  - Joint limits are kept in Model::joints[i].limits (continuous joints keep
 //    only effort and velocity limits).
 //  - Mesh files are resolved relative to the URDF's folder, as absolute paths,
-//    `file://` URIs, or `package://NAME/…` through the package search path.
+//    `file://` URIs, or `package://NAME/…` through the package search path
+//    (`package:///NAME/…` is read as `package://NAME/…`, with a warning).
 #pragma once
 
 #include <appell/scene.hpp>
@@ -33,7 +34,8 @@ struct LoadOptions {
   /// AMENT_PREFIX_PATH (colon-separated install prefixes: <prefix>/share/<package>).
   bool use_ros_package_path = true;
   /// Read mesh files (visual and collision). When false, mesh geometry keeps
-  /// its resolved path but no triangles, and a missing file is still an error.
+  /// its resolved path but no triangles, and a missing file a contact takes
+  /// its shape from is still an error (other missing meshes are warnings).
   bool load_meshes = true;
   /// loadScene: check the initial state against the constraints (see
   /// checkInitialState) with this tolerance; project it instead of failing
@@ -59,7 +61,8 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
                           const std::string& name = "<string>",
                           const LoadOptions& options = {});
 
-/// Resolves a mesh URI as the loader does: `package://NAME/rest`, `file://path`,
+/// Resolves a mesh URI as the loader does: `package://NAME/rest` (also with
+/// three slashes, `package:///NAME/rest`), `file://path`,
 /// an absolute path, or a path relative to `base_dir`. Returns the absolute
 /// path; throws SceneError (naming `uri` and every folder searched) when the
 /// file does not exist.

@@ -64,7 +64,7 @@ SupportMotion parseMotion(const XmlSource& src, const TiXmlElement* support) {
 }
 
 SupportDecl parseSupport(const XmlSource& src, const TiXmlElement* e, const std::string& base_dir,
-                         const LoadOptions& options) {
+                         const LoadOptions& options, std::vector<std::string>& warnings) {
   SupportDecl d;
   d.element = e;
   d.name = text(src, e, "name");
@@ -91,6 +91,7 @@ SupportDecl parseSupport(const XmlSource& src, const TiXmlElement* e, const std:
     d.terrain = true;
     const std::string uri = text(src, e, "filename");
     const Vec3 scale = vec3(src, e, "scale", Vec3::Ones());
+    if (const std::string note = packageUriNote(uri); !note.empty()) warnings.push_back(located(src, e, note));
     try {
       d.terrain_path = resolveMeshPath(uri, base_dir, options);
       d.terrain_mesh = std::make_shared<const TriangleMesh>(loadMesh(d.terrain_path, scale));
@@ -159,7 +160,18 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
     return std::nullopt;
   }
   const std::string name = text(src, e, "shape");
+  if (name == kSoleShape) {  // the collision geometry as a sole (buildSceneContents)
+    allow({"shape", "collision", "rim_points"});
+    return std::nullopt;
+  }
   const ShapeType* type = findShapeType(name);
+  // A box, a solid cylinder or a mesh has no smooth contact point: it touches
+  // with its vertices, and those come from the link's <collision> geometry.
+  if (type && !type->make && type->role == ShapeRole::CollisionOnly)
+    fail(src, e, "shape '" + name + "' is not declared in the <appell> block: a " + name +
+                     " touches with its vertices, taken from the collision geometry of the link — give the link "
+                     "<collision><geometry><" + name + " …/></geometry></collision> and write shape=\"" +
+                     kSoleShape + "\" (collision=\"NAME\" picks one of several)");
   if (type && !type->make)
     fail(src, e, "shape '" + name + "' cannot carry a contact: " + type->cannot_roll);
   if (!type) fail(src, e, "unknown shape '" + name + "' (known: " + declarableShapeNames() + ")");
@@ -184,6 +196,7 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
   d.spec.kind = parseKind(src, e);
   const std::optional<Shape> shape = parseExplicitShape(src, e);
   d.explicit_shape = shape.has_value();
+  d.sole = text(e, "shape", "") == kSoleShape;
   if (shape) d.spec.shape = *shape;
   const bool has_direction = has(e, "direction");
   if (has_direction) {
@@ -355,7 +368,14 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
   AppellBlock b;
   b.element = robot->FirstChildElement("appell");
   if (!b.element) return b;
-  allowOnly(src, b.element, {});
+  allowOnly(src, b.element, {"format"});
+  if (has(b.element, "format")) {
+    const std::string f = text(src, b.element, "format");
+    if (f != "1" && f != "2")
+      fail(src, b.element, "format \"" + f + "\" is not known: this loader reads format=\"1\" (scenes written "
+                           "before the planar joint's axes changed) and format=\"2\" (the current one)");
+    b.format = f == "1" ? 1 : 2;
+  }
   if (b.element->NextSiblingElement("appell")) fail(src, b.element->NextSiblingElement("appell"),
                                                     "more than one <appell> block");
   std::set<std::string> supports, contacts;
@@ -368,7 +388,7 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
       have_gravity = true;
       b.gravity = vec3(src, e, "xyz");
     } else if (tag == "support") {
-      SupportDecl d = parseSupport(src, e, base_dir, options);
+      SupportDecl d = parseSupport(src, e, base_dir, options, b.warnings);
       if (!supports.insert(d.name).second) fail(src, e, "support name '" + d.name + "' is used twice");
       b.supports.push_back(std::move(d));
     } else if (tag == "contact") {
@@ -417,6 +437,13 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
     if (!supports.count(c.support))
       fail(src, c.element, "unknown support '" + c.support + "'");
   return b;
+}
+
+std::set<std::string> AppellBlock::collisionLinks() const {
+  std::set<std::string> links;
+  for (const ContactDecl& c : contacts)
+    if (!c.explicit_shape) links.insert(c.link);
+  return links;
 }
 
 }  // namespace appell::io

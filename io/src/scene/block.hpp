@@ -29,7 +29,14 @@ struct ContactDecl {
   /// many vertices (standing on a face); 0: it is a wheel rim (disk or torus).
   int rim_points = 0;
   std::string collision;           ///< `collision=`: name or index of the geometry to use
+  /// shape="collision": the collision geometry as it is — a box's corners, a
+  /// mesh's hull vertices, a cylinder's rim polygons (standing on an end),
+  /// never a fitted wheel (a foot's sole).
+  bool sole = false;
 };
+
+/// The `shape` value that takes a contact's vertices from the link's collision geometry.
+inline constexpr const char* kSoleShape = "collision";
 
 struct JointStateDecl {
   const TiXmlElement* element = nullptr;
@@ -55,8 +62,14 @@ struct ActuatorDecl {
   bool own_limit = false;           ///< effort_limit given
 };
 
+/// The scene format this loader writes and reads by default (<appell format>).
+/// 1: before the planar joint's in-plane axes became the joint frame's x, y
+/// (commit 44be170; docs/scene-format.md, "Format versions"); 2: since.
+inline constexpr int kSceneFormat = 2;
+
 struct AppellBlock {
   const TiXmlElement* element = nullptr;  ///< null when the URDF has no <appell>
+  int format = 0;                         ///< <appell format="N">; 0 when not given
   Vec3 gravity{0, 0, -9.81};
   std::vector<SupportDecl> supports;
   std::vector<ContactDecl> contacts;
@@ -68,11 +81,22 @@ struct AppellBlock {
   const TiXmlElement* limits_element = nullptr;
   bool limits_enabled = true;
   double limits_restitution = 0;
+  /// What the block tolerated and how ("file:line: <element>: …").
+  std::vector<std::string> warnings;
+
+  /// The links whose collision geometry a contact takes its shape from
+  /// (their collision meshes must load).
+  std::set<std::string> collisionLinks() const;
 };
 
 /// Reads the <appell> child of <robot> (if any). Throws SceneError.
 AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
                              const std::string& base_dir, const LoadOptions& options);
+
+/// Reads the scene in the format its block declares (format.cpp): format 1's
+/// planar in-plane coordinates turned into the current axes; without a
+/// format, a warning for each planar joint whose axes changed.
+void applySceneFormat(const XmlSource& src, const AppellBlock& block, Scene& scene);
 
 /// Turns the declarations into the scene's supports, contacts, constraints,
 /// initial state and efforts, against the built model and link geometry.

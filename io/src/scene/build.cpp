@@ -24,23 +24,54 @@ std::string geometryLabel(int k, const Geometry& g) {
 // touching with its rim polygons. A sphere is itself. Boxes and meshes touch
 // with their vertices (vertex_contacts.hpp).
 // A rolling (or knife-edge) contact on a mesh wheel: the smooth shape fitted
-// about the wheel joint's axle (wheel_fit.hpp), said in `label`.
+// about the wheel joint's axle (wheel_fit.hpp), said in `label` — if the mesh
+// is round enough to be a wheel (isWheel); a foot's mesh about its ankle is
+// not, and the error says to declare it as a sole.
 Shape fittedWheel(const XmlSource& src, const ContactDecl& c, const Geometry& g, const Joint& joint,
                   std::string& label) {
   std::vector<Vec3> link_frame(g.mesh->vertices.size());
   for (std::size_t k = 0; k < link_frame.size(); ++k) link_frame[k] = g.origin.R * g.mesh->vertices[k] + g.origin.p;
+  WheelFit f;
   try {
-    const WheelFit f = fitWheel(link_frame, Vec3::Zero(), joint.axis);
-    std::ostringstream s;
-    s << label << ", fitted " << (f.torus ? "torus" : "disk") << " about the joint axle: radius "
-      << f.outer_radius;
-    if (f.torus) s << ", tyre radius " << f.tube_radius;
-    s << ", largest deviation " << f.max_deviation << " over " << f.tread_vertices << " tread vertices";
-    label = s.str();
-    return f.shape;
+    f = fitWheel(link_frame, Vec3::Zero(), joint.axis);
   } catch (const std::invalid_argument& e) {
     fail(src, c.element, label + ": " + e.what());
   }
+  std::ostringstream s;
+  s << label << ", fitted " << (f.torus ? "torus" : "disk") << " about the joint axle: radius "
+    << f.outer_radius;
+  if (f.torus) s << ", tyre radius " << f.tube_radius;
+  s << ", largest deviation " << f.max_deviation << " over " << f.tread_vertices
+    << " tread vertices, runout " << f.runout;
+  if (!isWheel(f)) {
+    std::ostringstream why;
+    why << s.str() << ": not a wheel — the runout of a wheel";
+    if (f.torus) why << " and tread deviation";
+    why << " stay within " << 100 * kWheelTolerance << " % of its radius (" << kWheelTolerance * f.outer_radius
+        << "). A foot or a sole: write shape=\"" << kSoleShape
+        << "\" (it touches with its hull vertices); a wheel: give its shape, e.g. shape=\"disk\" radius=\"…\" "
+           "axis=\"…\"";
+    fail(src, c.element, why.str());
+  }
+  label = s.str();
+  return f.shape;
+}
+
+// shape="collision": the geometry as a sole — a box's corners, a mesh's hull
+// vertices, a cylinder standing on an end (its rims as polygons), a sphere
+// as itself; never a fitted wheel.
+Shape soleShape(const XmlSource& src, const ContactDecl& c, const Geometry& g, const std::string& label) {
+  if (c.rim_points > 0 && g.type != GeometryType::Cylinder)
+    fail(src, c.element, "'rim_points' applies to a cylinder collision, not " + label);
+  switch (g.type) {
+    case GeometryType::Sphere: return Sphere{g.radius, g.origin.p};
+    case GeometryType::Cylinder: return Cylinder{g.radius, g.length, g.origin};
+    case GeometryType::Box: return Box{0.5 * g.box_size, g.origin};
+    case GeometryType::Mesh:
+      if (!g.mesh) fail(src, c.element, label + ": the mesh '" + g.mesh_path + "' was not loaded");
+      return Mesh{g.mesh_path, g.mesh_scale, g.origin, g.mesh->vertices, g.mesh->triangles};
+  }
+  fail(src, c.element, label + ": unknown geometry type");
 }
 
 bool rollsOnAWheel(ContactKind kind) { return kind != ContactKind::Sliding; }
@@ -79,14 +110,10 @@ Shape shapeOfGeometry(const XmlSource& src, const ContactDecl& c, const Geometry
   fail(src, c.element, label + ": unknown geometry type");
 }
 
-Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometry& geo,
-                   const Joint& joint, std::string& source) {
-  if (c.explicit_shape) {
-    if (!c.collision.empty()) fail(src, c.element, "give either 'collision' or an explicit shape, not both");
-    source = "explicit";
-    return c.spec.shape;
-  }
-  const auto& col = geo.collision;
+// Which of the link's collision geometries a contact takes: `collision=`
+// (a name or an index); else, for a wheel, the first that can roll (or the
+// first, whose error says why it cannot); for a sole, the only one.
+int pickCollision(const XmlSource& src, const ContactDecl& c, const std::vector<Geometry>& col) {
   if (col.empty())
     fail(src, c.element, "link '" + c.link + "' has no collision geometry to take the contact "
                          "shape from; give 'shape' or 'point'");
@@ -104,6 +131,13 @@ Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometr
     if (pick < 0)
       fail(src, c.element, "link '" + c.link + "' has no collision geometry named or numbered '" +
                                c.collision + "'");
+  } else if (c.sole && col.size() > 1) {
+    std::string list;
+    for (int k = 0; k < static_cast<int>(col.size()); ++k)
+      list += (k ? ", " : "") + geometryLabel(k, col[k]);
+    fail(src, c.element, "link '" + c.link + "' has " + std::to_string(col.size()) +
+                             " collision geometries: say which one is the sole with collision=\"NAME\" "
+                             "or collision=\"INDEX\" (" + list + ")");
   } else {
     // The first geometry that can roll; if none can, the first one (whose
     // error says why it cannot).
@@ -111,8 +145,23 @@ Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometr
       if (col[k].type == GeometryType::Sphere || col[k].type == GeometryType::Cylinder) pick = k;
     if (pick < 0) pick = 0;
   }
-  source = geometryLabel(pick, col[pick]);
-  return shapeOfGeometry(src, c, col[pick], joint, source);
+  return pick;
+}
+
+Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometry& geo,
+                   const Joint& joint, std::string& source) {
+  if (c.explicit_shape) {
+    if (!c.collision.empty()) fail(src, c.element, "give either 'collision' or an explicit shape, not both");
+    source = "explicit";
+    return c.spec.shape;
+  }
+  const int pick = pickCollision(src, c, geo.collision);
+  const Geometry& g = geo.collision[pick];
+  source = geometryLabel(pick, g);
+  if (!c.sole) return shapeOfGeometry(src, c, g, joint, source);
+  const Shape sole = soleShape(src, c, g, source);
+  source += ", as a sole";
+  return sole;
 }
 
 void setJointState(const XmlSource& src, const Model& model, const JointStateDecl& d, VecX& q,
@@ -305,6 +354,7 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
     scene.actuators.push_back(std::move(a));
   }
   scene.settings = block.settings;
+  applySceneFormat(src, block, scene);
 }
 
 }  // namespace appell::io

@@ -15,11 +15,14 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   const TiXmlElement* robot = io::parseDocument(src, doc, xml);
   const io::UrdfRobot urdf = io::readUrdf(src, robot);
   const io::AppellBlock block = io::parseAppellBlock(src, robot, base_dir, options);
-  io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity);
+  io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity, block.collisionLinks());
   Scene scene;
   scene.model = std::move(parsed.model);
   scene.geometry = std::move(parsed.geometry);
-  scene.warnings = std::move(parsed.warnings);
+  // Warnings in the order the loader met them: the URDF, its meshes, the block.
+  scene.warnings = urdf.warnings;
+  scene.warnings.insert(scene.warnings.end(), parsed.warnings.begin(), parsed.warnings.end());
+  scene.warnings.insert(scene.warnings.end(), block.warnings.begin(), block.warnings.end());
   scene.source = name;
   io::buildSceneContents(src, urdf, block, options, scene);
   if (options.check_initial_state)

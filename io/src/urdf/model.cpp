@@ -4,6 +4,7 @@
 #include "urdf/urdf_internal.hpp"
 
 #include <map>
+#include <set>
 
 namespace appell::io {
 
@@ -26,12 +27,34 @@ class MeshCache {
   std::map<std::string, std::shared_ptr<const TriangleMesh>> cache_;
 };
 
+// One line for a tolerance met many times in a file (a package's every mesh
+// URI written alike): the first place it was met, and how many more.
+class WarningTally {
+ public:
+  explicit WarningTally(std::string more) : more_(std::move(more)) {}
+  void add(std::string warning) {
+    if (count_++ == 0) first_ = std::move(warning);
+  }
+  void appendTo(std::vector<std::string>& out) const {
+    if (count_ == 0) return;
+    out.push_back(count_ == 1 ? first_
+                              : first_ + " (and " + std::to_string(count_ - 1) + " more " + more_ + ")");
+  }
+
+ private:
+  std::string more_, first_;
+  int count_ = 0;
+};
+
 // The geometry as read, with its mesh resolved (and loaded if asked);
-// resolution errors name the <mesh> element.
+// resolution errors name the <mesh> element, a URI form the loader
+// tolerates is noted in `uri_notes`.
 Geometry resolve(const XmlSource& src, const UrdfGeometry& in, const std::string& base_dir,
-                 const LoadOptions& options, MeshCache& cache) {
+                 const LoadOptions& options, MeshCache& cache, WarningTally& uri_notes) {
   Geometry out = in.geometry;
   if (out.type != GeometryType::Mesh) return out;
+  if (const std::string note = packageUriNote(out.mesh_uri); !note.empty())
+    uri_notes.add(located(src, in.shape, note));
   try {
     out.mesh_path = resolveMeshPath(out.mesh_uri, base_dir, options);
     if (options.load_meshes) out.mesh = cache.get(out.mesh_path, out.mesh_scale);
@@ -41,15 +64,48 @@ Geometry resolve(const XmlSource& src, const UrdfGeometry& in, const std::string
   return out;
 }
 
+// A link's visual and collision geometry, resolved. A visual mesh only
+// draws the link: one that cannot be found or read is left out with a
+// warning (as RViz does). So is a collision mesh of a link no contact takes
+// its shape from (`strict_collision` false): the dynamics never read it —
+// urdfdom does not open mesh files at all, and a published package often
+// ships without some of them. A collision mesh a contact uses stays an error.
+LinkGeometry resolveLinkGeometry(const XmlSource& src, const UrdfLink& link, const std::string& base_dir,
+                                 const LoadOptions& options, bool strict_collision, MeshCache& cache,
+                                 WarningTally& uri_notes, std::vector<std::string>& warnings,
+                                 WarningTally& unused_missing) {
+  LinkGeometry geo;
+  geo.link = link.name;
+  for (const UrdfGeometry& v : link.visual) {
+    try {
+      geo.visual.push_back(resolve(src, v, base_dir, options, cache, uri_notes));
+    } catch (const SceneError& e) {
+      warnings.push_back(std::string(e.what()) + " — visual only: the link is not drawn with it");
+    }
+  }
+  for (const UrdfGeometry& c : link.collision) {
+    try {
+      geo.collision.push_back(resolve(src, c, base_dir, options, cache, uri_notes));
+    } catch (const SceneError& e) {
+      if (strict_collision) throw;
+      unused_missing.add(std::string(e.what()) + " — collision of link '" + link.name +
+                         "', which no contact takes its shape from: left out");
+    }
+  }
+  return geo;
+}
+
 }  // namespace
 
 Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string& base_dir,
-                 const LoadOptions& options, const Vec3& gravity) {
+                 const LoadOptions& options, const Vec3& gravity,
+                 const std::set<std::string>& contact_links) {
   ModelBuilder builder;
   builder.setGravity(gravity);
   std::map<std::string, int> body_of_link;
   Robot robot;
   MeshCache cache;
+  WarningTally uri_notes("mesh URIs like it"), unused_missing("collision meshes no contact uses");
   for (const std::string& name : urdf.body_order) {
     const UrdfLink& link = urdf.links.at(name);
     int parent = -1;
@@ -77,23 +133,13 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
     } catch (const ModelError& e) {
       fail(src, link.element, e.what());
     }
-    LinkGeometry geo;
-    geo.link = name;
+    LinkGeometry geo = resolveLinkGeometry(src, link, base_dir, options, contact_links.count(name) > 0,
+                                           cache, uri_notes, robot.warnings, unused_missing);
     geo.body = body_of_link[name];
-    // A visual mesh only draws the link: one that cannot be found or read
-    // is left out with a warning (as RViz does), not an error; collision
-    // meshes carry contacts and stay errors.
-    for (const UrdfGeometry& v : link.visual) {
-      try {
-        geo.visual.push_back(resolve(src, v, base_dir, options, cache));
-      } catch (const SceneError& e) {
-        robot.warnings.push_back(std::string(e.what()) + " — visual only: the link is not drawn with it");
-      }
-    }
-    for (const UrdfGeometry& c : link.collision)
-      geo.collision.push_back(resolve(src, c, base_dir, options, cache));
     robot.geometry.push_back(std::move(geo));
   }
+  uri_notes.appendTo(robot.warnings);
+  unused_missing.appendTo(robot.warnings);
   try {
     robot.model = builder.build();
   } catch (const ModelError& e) {

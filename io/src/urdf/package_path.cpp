@@ -1,6 +1,8 @@
 // Resolution of mesh URIs: package://, file://, absolute and relative paths.
 #include <appell/urdf.hpp>
 
+#include "urdf/urdf_internal.hpp"
+
 #include <tinyxml.h>
 
 #include <sys/stat.h>
@@ -131,10 +133,15 @@ std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
   fs::path path;
   const std::string pkg = "package://", file = "file://";
   if (uri.rfind(pkg, 0) == 0) {
-    const std::string rest = uri.substr(pkg.size());
+    // `package:///NAME/…` (three slashes, as some published descriptions
+    // write it) is `package://NAME/…`; the loader warns about it.
+    std::size_t start = pkg.size();
+    while (start < uri.size() && uri[start] == '/') ++start;
+    const std::string rest = uri.substr(start);
     const auto slash = rest.find('/');
     const std::string name = rest.substr(0, slash);
-    if (name.empty()) throw SceneError("mesh '" + uri + "': no package name");
+    if (name.empty()) throw SceneError("mesh '" + uri + "': no package name (write package://NAME/path/in/package, "
+                                          "or a path relative to the URDF's folder)");
     const std::string dir = findPackage(name, options);
     if (dir.empty()) {
       std::string searched;
@@ -159,5 +166,18 @@ std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
     throw SceneError("mesh '" + uri + "': file not found: " + path.string());
   return path.string();
 }
+
+namespace io {
+
+std::string packageUriNote(const std::string& uri) {
+  const std::string three = "package:///";
+  if (uri.rfind(three, 0) != 0) return "";
+  std::size_t start = three.size();
+  while (start < uri.size() && uri[start] == '/') ++start;
+  return "'" + uri + "' read as 'package://" + uri.substr(start) +
+         "' (a package URI has two slashes before the package name)";
+}
+
+}  // namespace io
 
 }  // namespace appell

@@ -110,6 +110,9 @@ namespace {
 // A .urdf.xacro given as it is: xacro elements (<xacro:macro>, …) or
 // substitutions (${…}, $(find …)) left in. One error, at the first one, says
 // what to do, instead of a cascade of "is not a number" and unknown elements.
+// Only content counts: xacro's own output keeps the xmlns:xacro declaration
+// on <robot> and holds no xacro at all, and urdfdom, Pinocchio, MuJoCo and
+// Drake ignore namespace declarations — so does this check.
 void rejectXacro(const XmlSource& src, const TiXmlElement* robot) {
   const std::string how =
       ": the file still holds unexpanded xacro — expand it first: xacro FILE.urdf.xacro > FILE.urdf";
@@ -120,8 +123,7 @@ void rejectXacro(const XmlSource& src, const TiXmlElement* robot) {
     const std::string tag = e->Value();
     if (tag.rfind("xacro:", 0) == 0) fail(src, e, "element <" + tag + ">" + how);
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
-      const std::string name = a->Name(), value = a->Value();
-      if (name == "xmlns:xacro") fail(src, e, "xmlns:xacro declared" + how);
+      const std::string value = a->Value();
       if (value.find("${") != std::string::npos || value.find("$(") != std::string::npos)
         fail(src, e, std::string("attribute ") + a->Name() + "=\"" + clipped(value) + "\"" + how);
     }
@@ -378,21 +380,32 @@ UrdfJoint readJoint(const XmlSource& src, const TiXmlElement* j) {
 // A <mimic> names a one-degree-of-freedom joint of this robot, and the
 // couplings do not go round in a circle (a joint that follows itself through
 // others is either redundant or contradicts itself). Chains are fine: each
-// link of the chain is its own constraint row.
-void checkMimics(const XmlSource& src, const UrdfRobot& ix) {
+// link of the chain is its own constraint row. A <mimic> on a fixed joint
+// moves nothing: it is dropped with a warning, as Pinocchio ignores it
+// (CAD exporters and xacro macros leave it on joints later fixed).
+void checkMimics(const XmlSource& src, UrdfRobot& ix) {
   for (const std::string& name : ix.joint_order) {
-    const UrdfJoint& j = ix.joints.at(name);
+    UrdfJoint& j = ix.joints.at(name);
     if (!j.mimic) continue;
     const UrdfMimic& m = *j.mimic;
+    if (j.type == JointType::Fixed) {
+      ix.warnings.push_back(located(src, m.element, "a fixed joint moves nothing: its <mimic> of '" +
+                                                        m.joint + "' is ignored"));
+      j.mimic.reset();
+      continue;
+    }
+    const std::string instead = " — remove the <mimic>, or couple revolute, continuous or prismatic joints";
     if (!oneDofJoint(j.type))
       fail(src, m.element, std::string("a ") + toString(j.type) +
-                               " joint cannot mimic (only revolute, continuous and prismatic joints)");
+                               " joint cannot mimic (only revolute, continuous and prismatic joints)" + instead);
     const auto leader = ix.joints.find(m.joint);
-    if (leader == ix.joints.end()) fail(src, m.element, "mimics joint '" + m.joint + "', which is not declared");
-    if (m.joint == name) fail(src, m.element, "joint '" + name + "' mimics itself");
+    if (leader == ix.joints.end())
+      fail(src, m.element, "mimics joint '" + m.joint + "', which is not declared (name a joint of this robot)");
+    if (m.joint == name) fail(src, m.element, "joint '" + name + "' mimics itself" + instead);
     if (!oneDofJoint(leader->second.type))
       fail(src, m.element, "mimics '" + m.joint + "', a " + toString(leader->second.type) +
-                               " joint (only revolute, continuous and prismatic joints can be followed)");
+                               " joint (only revolute, continuous and prismatic joints can be followed)" +
+                               instead);
     // Follow the chain of leaders; at most one step per joint.
     std::string at = m.joint;
     for (std::size_t steps = 0; steps <= ix.joint_order.size(); ++steps) {

@@ -15,6 +15,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,8 @@ struct UrdfRobot {
   bool has_world = false;
   /// Links in depth-first order from the root (the root first), without "world".
   std::vector<std::string> body_order;
+  /// What the reader tolerated and how ("file:line: <element>: …"), for Scene::warnings.
+  std::vector<std::string> warnings;
 };
 
 /// Reads the <robot> element, checking as it goes: the version, names,
@@ -84,9 +87,17 @@ struct Robot {
 };
 
 /// Builds the model and the link geometry (meshes resolved and, if the
-/// options say so, loaded) from what readUrdf read.
+/// options say so, loaded) from what readUrdf read. A collision mesh that
+/// cannot be found or read is an error on the links of `contact_links` (a
+/// contact takes its shape from their collision geometry), elsewhere a
+/// warning, the geometry left out.
 Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string& base_dir,
-                 const LoadOptions& options, const Vec3& gravity);
+                 const LoadOptions& options, const Vec3& gravity,
+                 const std::set<std::string>& contact_links = {});
+
+/// The warning a mesh URI earns when the loader tolerates its form:
+/// `package:///NAME/…` is read as `package://NAME/…`. Empty when none.
+std::string packageUriNote(const std::string& uri);
 
 /// Whole file as a string; SceneError if it cannot be read.
 /// A scene file's text; refuses directories, devices, files over

@@ -30,8 +30,10 @@ std::string clipQuoted(const std::string& reason) {
   for (std::size_t i = 0; i < reason.size();) {
     const char c = reason[i];
     if (c == '\'' || c == '"') {
+      // The quoted value whole (a short one too: its closing quote must not
+      // open the next one), clipped when long.
       const std::size_t end = reason.find(c, i + 1);
-      if (end != std::string::npos && end - i - 1 > 64) {
+      if (end != std::string::npos) {
         out += c;
         out += clipped(reason.substr(i + 1, end - i - 1));
         out += c;
@@ -46,10 +48,14 @@ std::string clipQuoted(const std::string& reason) {
 }
 }  // namespace
 
-void fail(const XmlSource& src, const TiXmlElement* e, const std::string& reason) {
+std::string located(const XmlSource& src, const TiXmlElement* e, const std::string& reason) {
   std::string where = src.file;
   if (e && e->Row() > 0) where += ":" + std::to_string(e->Row());
-  throw SceneError(where + ": " + (e ? describe(e) + ": " : std::string()) + clipQuoted(reason));
+  return where + ": " + (e ? describe(e) + ": " : std::string()) + clipQuoted(reason);
+}
+
+void fail(const XmlSource& src, const TiXmlElement* e, const std::string& reason) {
+  throw SceneError(located(src, e, reason));
 }
 
 void fail(const XmlSource& src, const std::string& reason) {

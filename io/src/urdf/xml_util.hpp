@@ -21,6 +21,8 @@ struct XmlSource {
 /// "<joint name=\"j1\">" — the tag with its name attribute, if any.
 std::string describe(const TiXmlElement* e);
 
+/// "file:line: <element>: reason" — the form of every message (errors and warnings).
+std::string located(const XmlSource& src, const TiXmlElement* e, const std::string& reason);
 /// Throws SceneError "file:line: <element>: reason".
 [[noreturn]] void fail(const XmlSource& src, const TiXmlElement* e, const std::string& reason);
 /// Throws SceneError "file: reason".
