@@ -45,6 +45,8 @@ const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
   --no-joint-limits   ignore the URDF position limits of revolute and prismatic
                       joints (by default each finite one is a unilateral
                       constraint: the joint stops or bounces there)
+  --snap-angles TOL   snap origin angles within TOL rad of a multiple of π/2
+                      (CAD rounding: rpy="-1.57"), each change reported
   --quiet             no progress bar
   --max-energy-error E  stop when the work balance (E + impact and friction
                       losses − work of joint forces and moving supports − E0)
@@ -236,6 +238,16 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
            "independent; give its wheels a friction coefficient 'mu' so they can scrub, or "
            "align them)";
   out << "\n";
+  if (const NearDependency& d = r.near_dependency; d.found) {
+    out << "margin       ⚠ rows";
+    for (std::size_t k = 0; k < d.rows.size(); ++k) out << (k ? ", " : " ") << d.rows[k];
+    out << " are independent only by σ = " << d.sigma << " (" << d.margin()
+        << " × the rank threshold " << d.threshold << ") at t = " << d.t << " s (first at t = "
+        << d.t_first << " s; " << d.samples << " of " << d.checks
+        << " checks): they lock the motion";
+    for (const auto& [name, share] : d.freedom) out << " " << name << " " << share;
+    out << " — CAD rounding? (--snap-angles)\n";
+  }
   out << "events       ";
   int events = 0;
   if (r.partition_changes) {
@@ -402,7 +414,7 @@ int runSweep(const Scene& base, const OverrideReport& kept_base, const Args& arg
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
-             "max-energy-error", "max-residual", "settle-time", "set", "sweep", "format"},
+             "max-energy-error", "max-residual", "settle-time", "set", "sweep", "format", "snap-angles"},
             {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kRunHelp);

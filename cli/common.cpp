@@ -17,6 +17,7 @@ Scene loadFromArgs(const Args& args, bool check_initial) {
   opt.check_initial_state = check_initial;
   opt.project_initial_state = args.has("project-initial");
   opt.joint_limits = !args.has("no-joint-limits");
+  opt.snap_angles = args.number("snap-angles", 0);  // the loader checks its range
   Scene scene = loadScene(args.positional()[0], opt);
   for (const std::string& w : scene.warnings) std::cerr << "appell: warning: " << w << "\n";
   return scene;

@@ -40,6 +40,31 @@ void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out) {
   out.t2_rate = nd.cross(out.t1) + n.cross(out.t1_rate);
 }
 
+void transportedFrame(const Mat3& RS, const Vec3& Omega, ContactGeometry& out) {
+  const Vec3& n = out.normal;
+  const Vec3& nd = out.normal_rate;
+  const Vec3 p = RS.col(2);   // the pole
+  const Vec3 a = -RS.col(1);  // t1 at the pole
+  // 1 + p·n as |p + n|²/2: accurate near the antipode, where 1 + p·n cancels.
+  const Vec3 q = p + n;
+  const double k = 0.5 * q.squaredNorm();
+  if (!(k > kAntipode)) {
+    // n = −p to round-off: no limit exists (the hairy-ball point); the
+    // support's own axis, projected, keeps the rows finite and usable.
+    tangentFrame(a, Omega.cross(a), out);
+    return;
+  }
+  // t1 = R(p → n) a = a − (p + n)(n·a)/(1 + p·n), with ṗ = Ω × p, ȧ = Ω × a.
+  const Vec3 pd = Omega.cross(p), ad = Omega.cross(a);
+  const double alpha = n.dot(a) / k;
+  const double alpha_d = (nd.dot(a) + n.dot(ad)) / k;
+  const double k_d = q.dot(pd + nd);
+  out.t1 = a - q * alpha;
+  out.t1_rate = ad - (pd + nd) * alpha - q * (alpha_d - alpha * k_d / k);
+  out.t2 = n.cross(out.t1);
+  out.t2_rate = nd.cross(out.t1) + n.cross(out.t1_rate);
+}
+
 }  // namespace detail
 
 void contactGeometry(const Shape& shape, const SupportSurface& surface,

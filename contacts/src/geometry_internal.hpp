@@ -30,16 +30,22 @@ void finishPoint(const SE3& pose, const Twist& body, const GaussPoint& g, const 
 /// is ≥ |e|/√2).
 void tangentFrame(const Vec3& e, const Vec3& edot, ContactGeometry& out);
 
-/// A vector orthogonal to the unit n, in the direction of Eigen's
-/// n.unitOrthogonal() but not normalised (tangentFrame normalises): no
-/// square root on the evaluation path.
-inline Vec3 orthogonal(const Vec3& n) {
-  constexpr double kMuchSmaller = 1e-12;  // Eigen's dummy precision for double
-  if (std::abs(n.x()) > kMuchSmaller * std::abs(n.z()) ||
-      std::abs(n.y()) > kMuchSmaller * std::abs(n.z()))
-    return Vec3(-n.y(), n.x(), 0.0);
-  return Vec3(0.0, -n.z(), n.y());
-}
+/// The tangent frame of every smooth support (plane, sphere, terrain piece):
+/// the frame (−y_S, x_S) at the support's pole p = z_S (R_S's third column)
+/// carried to n along the great circle from p — the rotation R(p → n) about
+/// p × n, i.e. parallel transport on the unit sphere of normals:
+///     t1 = a − (p + n)(n·a)/(1 + p·n),  a = −y_S,   t2 = n × t1.
+/// A smooth function of n and R_S everywhere but at the antipode n = −p (no
+/// tangent field on a sphere lacks a singular point: the hairy-ball theorem),
+/// so the rows' frame never switches along a path that avoids it
+/// (docs/contacts.md §3). Needs n, ṅ in `out`; Ω is the support's angular
+/// velocity (ṗ = Ω × p, ȧ = Ω × a).
+void transportedFrame(const Mat3& RS, const Vec3& Omega, ContactGeometry& out);
+
+/// Within this of the antipode (1 + p·n ≤ kAntipode, 1.4 µrad), where the
+/// transported frame's round-off grows like ε/|p + n|, the frame is the
+/// support's −y axis projected onto the tangent plane instead.
+inline constexpr double kAntipode = 1e-12;
 
 void planeGeometry(const Shape& shape, const Plane& plane, const SupportState& S, const SE3& pose,
                    const Vec6& V, ContactGeometry& out, const GeometryOptions& opt);

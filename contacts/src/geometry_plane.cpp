@@ -28,14 +28,10 @@ void planeGeometry(const Shape& shape, const Plane& plane, const SupportState& S
   const Vec3 mdot = pose.R.transpose() * (body.w - sup.w).cross(n);
   finishPoint(pose, body, g, mdot, out);
 
-  // The tangent frame is fixed in the support frame: t1 = R_S ê with ê ⟂ n_S
-  // exactly (orthogonal() swaps components), so no projection is needed, and
-  // both tangents turn with the support, ṫ = Ω × t.
-  const Vec3 eS = orthogonal(nS);
-  out.t1 = S.pose.R * (eS / eS.norm());
-  out.t2 = n.cross(out.t1);
-  out.t1_rate = sup.w.cross(out.t1);
-  out.t2_rate = sup.w.cross(out.t2);
+  // The support's transported frame at n (fixed in the support frame here,
+  // so ṫ = Ω × t): a terrain's faces, edges and vertices take the same
+  // function of n, so a ball crossing them keeps a continuous frame.
+  transportedFrame(S.pose.R, sup.w, out);
   if (g.singular) markSingular(out, g.reason);
 }
 

@@ -71,10 +71,11 @@ void sphereSurfaceGeometry(const Shape& shape, const SphereSurface& sphere, cons
   out.normal_rate = body.w.cross(out.normal) - pose.R * mdot;
   finishPoint(pose, body, g, mdot, out);
 
-  // Reference direction fixed in the support frame, switched where it is near the normal.
-  Vec3 e = S.pose.R.col(0);
-  if ((e - out.normal * out.normal.dot(e)).squaredNorm() < 0.5) e = S.pose.R.col(1);
-  tangentFrame(e, sup.w.cross(e), out);
+  // The support's frame carried from its pole z_S along the great circle to
+  // n: continuous wherever the contact goes but the antipode (a ball on top
+  // of a globe, or at the bottom of a bowl, is at the pole). A reference axis
+  // switched where it nears n made the rows jump at 45° from that axis.
+  transportedFrame(S.pose.R, sup.w, out);
 
   if (!ok) markSingular(out, reason);
   else if (g.singular) markSingular(out, g.reason);

@@ -109,7 +109,7 @@ bool terrainEdgeGeometry(const Shape& shape, const Vec3& a_s, const Vec3& b_s,
   out.gap = gap;
   const Vec3 mdot = -(pose.R.transpose() * (ndot - body.w.cross(n)));
   finishPoint(pose, body, g, mdot, out);
-  tangentFrame(e, sup.w.cross(e), out);
+  transportedFrame(S.pose.R, sup.w, out);  // the faces' frame, continuous across pieces
   return true;
 }
 
@@ -174,8 +174,8 @@ Vec3 nearestOnPiece(const TerrainMesh& t, int feature, const Vec3& p) {
 void noPieceInReach(const SupportState& S, const SE3& pose, double reach, ContactGeometry& out) {
   out = ContactGeometry{};
   out.normal = S.pose.R.col(2);
-  out.t1 = S.pose.R.col(0);
-  out.t2 = S.pose.R.col(1);
+  out.t1 = -S.pose.R.col(1);  // the transported frame at the pole
+  out.t2 = S.pose.R.col(0);
   out.gap = reach;
   out.point = pose.p;
   out.support_point = pose.p - reach * out.normal;

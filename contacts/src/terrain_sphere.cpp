@@ -167,7 +167,7 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
     return;
   }
   const bool on_edge = feature < idx.regions + idx.edges;
-  Vec3 e;  // tangent reference: the edge (its welded ends in order), or a support axis away from n
+  Vec3 e = Vec3::Zero();  // on an edge: its direction (its welded ends in order)
   if (on_edge) {
     const auto& ends = idx.edge_ends[feature - idx.regions];
     const Vec3& a = terrain.vertices[ends[0]];
@@ -205,8 +205,6 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
     const Vec3 pu = u - e * e.dot(u);
     ndot += (pu - n * n.dot(pu)) / d;
   } else {
-    e = S.pose.R.col(0);
-    if ((e - n * n.dot(e)).squaredNorm() < 0.5) e = S.pose.R.col(1);
     ndot += (u - n * n.dot(u)) / d;
   }
   out.normal = n;
@@ -216,7 +214,7 @@ void terrainSphereGeometry(const Sphere& sphere, const TerrainMesh& terrain, con
   const GaussPoint g = inverseGaussMap(sphere, m, opt.singular_tol);
   const Vec3 mdot = -(pose.R.transpose() * (ndot - body.w.cross(n)));
   finishPoint(pose, body, g, mdot, out);
-  tangentFrame(e, sup.w.cross(e), out);
+  transportedFrame(S.pose.R, sup.w, out);  // the faces' frame, continuous across pieces
 }
 
 }  // namespace appell::detail

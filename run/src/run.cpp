@@ -2,6 +2,7 @@
 #include <appell/divergence_watch.hpp>
 
 #include "contact_stats.hpp"
+#include "rank_margin.hpp"
 #include "step_stability.hpp"
 #include "vertex_watch.hpp"
 
@@ -180,6 +181,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     }
   };
   record(sim);
+  run_detail::RankMarginWatch margins(scene, options);  // rows independent only by a margin
+  margins.sample(sim, true, s.near_dependency);
   if (on_sample) on_sample(sim);
 
   const auto wall0 = std::chrono::steady_clock::now();
@@ -248,6 +251,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     ++step;
     if (adaptive) h = status.h_next;
     record(sim);
+    margins.sample(sim, !sim.events().empty(), s.near_dependency);
     s.max_energy_deviation = std::max(s.max_energy_deviation, deviation);
     s.max_velocity_residual = std::max(s.max_velocity_residual, sim.velocityResidual());
     s.max_gap_residual = std::max(s.max_gap_residual, sim.gapResidual());

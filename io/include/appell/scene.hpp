@@ -84,6 +84,9 @@ struct SimulationSettings {
   double tol = 1e-8;               ///< adaptive methods: relative tolerance
   double duration = 1.0;
   std::string formulation = "tree";  ///< a canonical name of formulationTable()
+  /// Snap origin angles within this of a multiple of π/2 (rad; 0: no snap):
+  /// LoadOptions::snap_angles, which overrides it when set.
+  double snap_angles = 0;
 };
 
 /// The vertex contacts one <contact> on a box, mesh or standing cylinder

@@ -46,6 +46,13 @@ struct LoadOptions {
   /// unilateral constraints (Scene::joint_limits); false ignores them.
   bool joint_limits = true;
   double initial_state_tolerance = 1e-8;
+  /// Opt-in snap of CAD rounding (rad; 0: the scene's <simulation
+  /// snap_angles>, itself 0 by default: none): every roll, pitch and yaw of a
+  /// joint's or a link's visual/collision <origin rpy> within this of a
+  /// multiple of π/2 becomes that multiple exactly, each change reported in
+  /// Scene::warnings (rpy="-1.57" is a wheel 7.96e-4 rad off its axle: a
+  /// rigid model takes it literally). At most 0.05 rad.
+  double snap_angles = 0;
 };
 
 /// Model only (links, joints, inertias, limits, gravity from the `<appell>`

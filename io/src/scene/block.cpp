@@ -1,5 +1,6 @@
 // Parsing of the `<appell>` scene block (docs/scene-format.md).
 #include "scene/block.hpp"
+#include "urdf/snap_angles.hpp"
 
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
@@ -346,7 +347,7 @@ ActuatorDecl parseActuator(const XmlSource& src, const TiXmlElement* e) {
 }
 
 SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
-  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation"});
+  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation", "snap_angles"});
   SimulationSettings s;
   // Both names are stored canonical ("multipliers" reads as "kkt").
   try {
@@ -358,6 +359,12 @@ SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) 
   if (has(e, "dt")) s.dt = positive(src, e, "dt");
   if (has(e, "tol")) s.tol = positive(src, e, "tol");
   if (has(e, "duration")) s.duration = positive(src, e, "duration");
+  if (has(e, "snap_angles")) {
+    s.snap_angles = positive(src, e, "snap_angles");
+    if (s.snap_angles > kMaxSnapAngle)
+      fail(src, e, "snap_angles must be at most 0.05 rad: angles further from a multiple of "
+                   "π/2 are design, not rounding");
+  }
   return s;
 }
 

@@ -1,6 +1,7 @@
 // The loader's entry points: one parse of the text, one read of the URDF and
 // of the <appell> block from that DOM, then the build — all or nothing.
 #include "scene/block.hpp"
+#include "urdf/snap_angles.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -13,9 +14,13 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   const io::XmlSource src{name};
   TiXmlDocument doc;
   const TiXmlElement* robot = io::parseDocument(src, doc, xml);
-  const io::UrdfRobot urdf = io::readUrdf(src, robot);
+  io::UrdfRobot urdf = io::readUrdf(src, robot);
   const io::AppellBlock block = io::parseAppellBlock(src, robot, base_dir, options);
+  const double snap = options.snap_angles > 0 ? options.snap_angles : block.settings.snap_angles;
+  const std::vector<std::string> snapped = snap > 0 ? io::snapAngles(src, snap, urdf)
+                                                    : std::vector<std::string>{};
   io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity, block.collisionLinks());
+  parsed.warnings.insert(parsed.warnings.begin(), snapped.begin(), snapped.end());
   Scene scene;
   scene.model = std::move(parsed.model);
   scene.geometry = std::move(parsed.geometry);

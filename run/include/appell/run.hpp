@@ -73,6 +73,12 @@ struct RunOptions {
   /// ContactEventOptions::settle_time: sliding contacts whose slip direction
   /// settles faster slide on their settled directions (0: never).
   double settle_time = ContactEventOptions{}.settle_time;
+  /// Near-dependency watch (run/src/rank_margin.cpp): closed rows whose
+  /// smallest kept singular value (equilibrated, mass metric) is below this
+  /// are reported as independent only by a margin — rows that an exact
+  /// design makes dependent and CAD rounding made independent, locking a
+  /// freedom (RunSummary::near_dependency). 0 switches the watch off.
+  double near_dependency_level = 1e-3;
 };
 
 /// The scene's own settings as run options. Throws std::invalid_argument for
@@ -131,6 +137,34 @@ struct RunEvent {
   std::string piece;
 };
 
+/// Closed rows independent only by a small margin, seen at some sample of
+/// the run (run/src/rank_margin.cpp). With B = L⁻¹Aᵀ the closed rows in the
+/// mass metric (M = LLᵀ), columns scaled to unit norm, and σ₁ ≥ … ≥ σᵣ its
+/// singular values above the solvers' rank threshold (rank_abs_tol +
+/// rank_rel_tol), σᵣ below `RunOptions::near_dependency_level` means: the
+/// solvers keep those rows as independent (σᵣ is above the threshold), but
+/// by a margin of round-off or CAD rounding; the motion they nearly allow is
+/// locked. Recorded at the sample where σᵣ was smallest.
+struct NearDependency {
+  bool found = false;
+  double t_first = -1;             ///< first sample where it was seen (s)
+  double t = 0;                    ///< the sample with the smallest margin (s)
+  double sigma = 0;                ///< σᵣ there
+  double threshold = 0;            ///< the rank threshold (σ at or below it: redundant)
+  /// The rows the near-dependency combines ("left_tyre.tangent1"), largest
+  /// share first: the right singular vector of σᵣ, entries ≥ 0.2 of its largest.
+  std::vector<std::string> rows;
+  /// The freedom lost: the motion L⁻ᵀu (u the left singular vector of σᵣ)
+  /// that violates the rows only by σᵣ, by velocity coordinate (CSV names,
+  /// "root_joint.wz"), largest first, with its components relative to the
+  /// largest; entries ≥ 0.2 of it.
+  std::vector<std::pair<std::string, double>> freedom;
+  long samples = 0;                ///< samples where some σᵣ was below the level
+  long checks = 0;                 ///< samples checked
+  /// How many times the threshold σᵣ is.
+  double margin() const { return threshold > 0 ? sigma / threshold : 0; }
+};
+
 struct RunSummary {
   RunOptions options;
   bool ok = true;                  ///< every step succeeded
@@ -156,6 +190,8 @@ struct RunSummary {
   /// nv − rank(A) (0: nothing can move — an over-constrained vehicle whose
   /// axles are out of line, which the CLI warns about).
   int free_velocities = 0;
+  /// Rows independent only by a margin at some sample (found = false: none).
+  NearDependency near_dependency;
   /// Some contact has friction rows with a finite μ: with free_velocities 0
   /// the scene is held while its contacts stick, and moves only by slipping
   /// (a braked car parked on a slope), not stuck for good.
