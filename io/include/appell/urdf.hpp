@@ -19,6 +19,7 @@
 
 #include <appell/scene.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,13 @@ struct LoadOptions {
   /// unilateral constraints (Scene::joint_limits); false ignores them.
   bool joint_limits = true;
   double initial_state_tolerance = 1e-8;
+  /// Repairs of inertias as published (InertiaRepairs, model.hpp; MuJoCo's
+  /// balanceinertia, boundinertia, boundmass): each one set here overrides
+  /// the scene's <simulation balance_inertia bound_inertia bound_mass>; left
+  /// unset, the scene's applies (none by default). Every repaired body gets a
+  /// line in Scene::warnings.
+  std::optional<bool> balance_inertia;
+  std::optional<double> bound_inertia, bound_mass;
 };
 
 /// Model only (links, joints, inertias, limits, gravity from the `<appell>`

@@ -333,7 +333,8 @@ ActuatorDecl parseActuator(const XmlSource& src, const TiXmlElement* e) {
 }
 
 SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
-  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation"});
+  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation", "balance_inertia",
+                     "bound_inertia", "bound_mass"});
   SimulationSettings s;
   // Both names are stored canonical ("multipliers" reads as "kkt").
   try {
@@ -346,6 +347,21 @@ SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) 
   if (has(e, "tol")) s.tol = positive(src, e, "tol");
   if (has(e, "duration")) s.duration = positive(src, e, "duration");
   return s;
+}
+
+// The inertia repairs of <simulation> (InertiaRepairs, model.hpp): a flag and
+// two bounds ≥ 0 (kg m², kg).
+InertiaRepairs parseInertiaRepairs(const XmlSource& src, const TiXmlElement* e) {
+  InertiaRepairs r;
+  const std::string balance = text(e, "balance_inertia", "false");
+  if (balance != "true" && balance != "false") fail(src, e, "'balance_inertia' must be \"true\" or \"false\"");
+  r.balance = balance == "true";
+  for (auto [attr, bound] : {std::pair{"bound_inertia", &r.bound_inertia}, std::pair{"bound_mass", &r.bound_mass}}) {
+    if (!has(e, attr)) continue;
+    *bound = number(src, e, attr);
+    if (*bound < 0) fail(src, e, std::string("'") + attr + "' must be ≥ 0 (a lower bound; 0: none)");
+  }
+  return r;
 }
 
 }  // namespace
@@ -408,6 +424,7 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
       if (have_simulation) fail(src, e, "<simulation> is given twice");
       have_simulation = true;
       b.settings = parseSimulation(src, e);
+      b.repairs = parseInertiaRepairs(src, e);
     } else {
       fail(src, e, "unknown element <" + tag +
                        "> in <appell> (known: gravity, support, contact, initial, effort, actuator, joint_limits, simulation)");

@@ -15,7 +15,8 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   const TiXmlElement* robot = io::parseDocument(src, doc, xml);
   const io::UrdfRobot urdf = io::readUrdf(src, robot);
   const io::AppellBlock block = io::parseAppellBlock(src, robot, base_dir, options);
-  io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity);
+  io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity,
+                                    io::inertiaRepairs(options, block.repairs));
   Scene scene;
   scene.model = std::move(parsed.model);
   scene.geometry = std::move(parsed.geometry);

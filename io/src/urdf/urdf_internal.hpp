@@ -84,9 +84,14 @@ struct Robot {
 };
 
 /// Builds the model and the link geometry (meshes resolved and, if the
-/// options say so, loaded) from what readUrdf read.
+/// options say so, loaded) from what readUrdf read, with the inertias
+/// repaired as asked; each inertia loaded with a defect or repaired adds a
+/// warning "file:line: <link name=…>: body '…': …".
 Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string& base_dir,
-                 const LoadOptions& options, const Vec3& gravity);
+                 const LoadOptions& options, const Vec3& gravity, const InertiaRepairs& repairs);
+
+/// The repairs in force: each one LoadOptions sets, else the scene's.
+InertiaRepairs inertiaRepairs(const LoadOptions& options, const InertiaRepairs& scene);
 
 /// Whole file as a string; SceneError if it cannot be read.
 /// A scene file's text; refuses directories, devices, files over
