@@ -67,6 +67,12 @@ double Args::positiveNumber(const std::string& name, double fallback) const {
   return x;
 }
 
+double Args::nonNegativeNumber(const std::string& name) const {
+  const double x = number(name, 0.0);
+  if (!(x >= 0)) throw UsageError("option --" + name + " must be ≥ 0 (a lower bound; 0: none)");
+  return x;
+}
+
 int Args::integer(const std::string& name, int fallback) const {
   const double x = number(name, fallback);
   if (x != std::floor(x) || std::abs(x) > 1e9)

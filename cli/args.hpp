@@ -25,6 +25,8 @@ class Args {
   /// A finite number; throws UsageError naming the option otherwise.
   double number(const std::string& name, double fallback) const;
   double positiveNumber(const std::string& name, double fallback) const;
+  /// A finite number ≥ 0 (a lower bound, where 0 means none).
+  double nonNegativeNumber(const std::string& name) const;
   int integer(const std::string& name, int fallback) const;
   /// Comma-separated list.
   std::vector<std::string> list(const std::string& name) const;

@@ -30,13 +30,13 @@ along a line) are reported as one set.
   --seed K          random seed (default 1)
   --tol TOL         scaled residual tolerance (default 1e-10)
   --package-path DIRS
-)";
+)" APPELL_INERTIA_HELP;
 
 }  // namespace
 
 int equilibria(int argc, char** argv) {
-  Args args(argc, argv, 2, {"starts", "spread", "seed", "tol", "package-path"},
-            {"help", "project-initial", "no-joint-limits"});
+  Args args(argc, argv, 2, {"starts", "spread", "seed", "tol", "package-path", "bound-inertia", "bound-mass"},
+            {"help", "project-initial", "no-joint-limits", "balance-inertia"});
   if (args.has("help")) {
     std::cout << kEquilibriaHelp;
     return 0;

@@ -17,14 +17,18 @@ namespace appell::cli {
 namespace {
 
 const char* kInfoHelp = R"(usage: appell info SCENE.urdf [--package-path DIRS] [--project-initial] [--no-joint-limits]
+                         [--balance-inertia] [--bound-inertia V] [--bound-mass M]
 
 Prints the bodies (joint type, parent, mass), the degrees of freedom (nq, nv),
 the links merged on fixed joints, the meshes (triangles, vertices), every
 contact with its kind, support, shape and rows, the joint limits, actuators
 and mimic couplings, and at the initial state
 the rank of the constraint rows: redundant rows (e.g. a four-wheeled car) and
-the residuals of the initial state.
-)";
+the residuals of the initial state. Inertias loaded with a defect (principal
+moments that break the triangle inequality, a near-massless body carried by
+its children) or repaired are named in warnings on stderr.
+
+)" APPELL_INERTIA_HELP;
 
 }  // namespace
 

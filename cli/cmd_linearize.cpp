@@ -52,7 +52,7 @@ scene's initial state and prints the eigenvalues.
 
 Exit status 3 when the reference is not an equilibrium / steady motion.
   --package-path DIRS
-)";
+)" APPELL_INERTIA_HELP;
 
 struct Analysis {
   bool ok = false;             ///< a verdict: the reference is an equilibrium / steady motion
@@ -267,8 +267,9 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
 
 int linearize(int argc, char** argv) {
   Args args(argc, argv, 2,
-            {"cyclic", "formulation", "zero-tol", "package-path", "fd-step", "set", "sweep", "format", "plot"},
-            {"help", "equilibrium", "project-initial", "no-joint-limits"});
+            {"cyclic", "formulation", "zero-tol", "package-path", "fd-step", "set", "sweep", "format", "plot",
+             "bound-inertia", "bound-mass"},
+            {"help", "equilibrium", "project-initial", "no-joint-limits", "balance-inertia"});
   if (args.has("help")) {
     std::cout << helpText(kLinearizeHelp);
     return 0;

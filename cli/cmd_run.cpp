@@ -47,7 +47,7 @@ const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
                       constraint: the joint stops or bounces there)
   --snap-angles TOL   snap origin angles within TOL rad of a multiple of π/2
                       (CAD rounding: rpy="-1.57"), each change reported
-  --quiet             no progress bar
+)" APPELL_INERTIA_HELP R"(  --quiet             no progress bar
   --max-energy-error E  stop when the work balance (E + impact and friction
                       losses − work of joint forces and moving supports − E0)
                       is off by more than E relative, keeping the last state
@@ -208,8 +208,12 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
       << scene.contacts.size() << " contacts, ";
   if (!scene.joint_limits.empty()) out << scene.joint_limits.size() << " joint limits, ";
   if (!scene.couplings.empty()) out << scene.couplings.size() << " mimic couplings, ";
-  out << scene.constraintRows() << " rows\n"
-      << "method       " << toString(o.integrator) << (adaptive ? " (tol " : " (dt ")
+  out << scene.constraintRows() << " rows\n";
+  // The load's warnings (an inertia loaded with a defect or repaired, a
+  // missing visual mesh) went to stderr before the run; the summary counts them.
+  if (!scene.warnings.empty())
+    out << "warnings     " << scene.warnings.size() << " at load, printed before the run\n";
+  out << "method       " << toString(o.integrator) << (adaptive ? " (tol " : " (dt ")
       << (adaptive ? o.tol : o.dt) << "), formulation " << toString(o.formulation) << "\n"
       << "simulated    " << r.time << " s in " << c.steps << " steps";
   if (c.rejected) out << " (" << c.rejected << " rejected)";
@@ -414,8 +418,9 @@ int runSweep(const Scene& base, const OverrideReport& kept_base, const Args& arg
 int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
+             "bound-inertia", "bound-mass",
              "max-energy-error", "max-residual", "settle-time", "set", "sweep", "format", "snap-angles"},
-            {"project-initial", "no-joint-limits", "help", "no-projection", "quiet", "plot"});
+            {"project-initial", "no-joint-limits", "balance-inertia", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kRunHelp);
     return 0;

@@ -36,7 +36,7 @@ page loads nothing). Open it in a browser: play/pause, scrub, orbit with the mou
   --out PAGE.html       where to write the page (default: SCENE name + .html)
   --package-path DIRS   colon/comma-separated folders for package:// meshes
   --project-initial     project an initial state that violates the constraints
-
+)" APPELL_INERTIA_HELP R"(
 Page URL options (after #): t=2.5 (show that time), view=top (orthographic from
 above), center=x,y and span=S (top view framing, metres), play=1.
 )";

@@ -15,8 +15,17 @@ int view(int argc, char** argv);
 int plot(int argc, char** argv);
 
 /// Options every command that loads a scene accepts.
-inline const std::set<std::string> kLoadOptions = {"package-path"};
-inline const std::set<std::string> kLoadFlags = {"project-initial", "no-joint-limits", "help"};
+inline const std::set<std::string> kLoadOptions = {"package-path", "bound-inertia", "bound-mass"};
+inline const std::set<std::string> kLoadFlags = {"project-initial", "no-joint-limits", "balance-inertia",
+                                                 "help"};
+/// Their help lines for the inertia repairs (InertiaRepairs, model.hpp).
+#define APPELL_INERTIA_HELP \
+  "  --balance-inertia   raise each body's smallest principal moment to I3 - I2 where\n" \
+  "                      the moments break the triangle inequality (CAD rounding)\n" \
+  "  --bound-inertia V   raise every principal moment below V kg m^2 to V\n" \
+  "  --bound-mass M      raise every moving body's mass below M kg to M\n" \
+  "                      (each overrides the scene's <simulation> attribute; every\n" \
+  "                      repaired body is named in a warning)\n"
 
 /// Loads the scene named by the single positional argument.
 Scene loadFromArgs(const Args& args, bool check_initial = true);

@@ -18,6 +18,9 @@ Scene loadFromArgs(const Args& args, bool check_initial) {
   opt.project_initial_state = args.has("project-initial");
   opt.joint_limits = !args.has("no-joint-limits");
   opt.snap_angles = args.number("snap-angles", 0);  // the loader checks its range
+  if (args.has("balance-inertia")) opt.balance_inertia = true;
+  if (args.has("bound-inertia")) opt.bound_inertia = args.nonNegativeNumber("bound-inertia");
+  if (args.has("bound-mass")) opt.bound_mass = args.nonNegativeNumber("bound-mass");
   Scene scene = loadScene(args.positional()[0], opt);
   for (const std::string& w : scene.warnings) std::cerr << "appell: warning: " << w << "\n";
   return scene;

@@ -420,3 +420,33 @@ TEST(Cli, AHeaderNameWithALineBreakReadsBack) {
   EXPECT_EQ(t.rows[1][2], 4.0);
   std::filesystem::remove(csv);
 }
+
+// Inertias as published (tests/data/io/inertia): every command that loads a
+// scene prints the one warning of a defective link on stderr, `run` counts it
+// in its summary, and the repair flags change it into what they did.
+TEST(Cli, InertiaWarningsAndRepairFlags) {
+  const std::string arm = std::string(APPELL_SOURCE_DIR) + "/tests/data/io/inertia/arm_triangle.urdf";
+  const Result info = sh("info " + arm);
+  EXPECT_EQ(info.status, 0) << info.output;
+  EXPECT_NE(info.output.find("appell: warning: " + arm + ":20: <link name=\"arm_left_1_link\">: body "
+                             "'arm_left_1_link': principal moments 0.00155679 0.00597627 0.00777394 "
+                             "violate the triangle inequality by 3.09853 %"),
+            std::string::npos)
+      << info.output;
+  const Result run = sh("run " + arm + " --duration 0.01 --quiet");
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("warnings     1 at load, printed before the run"), std::string::npos) << run.output;
+  const Result balanced = sh("info " + arm + " --balance-inertia --bound-mass 0.5");
+  EXPECT_EQ(balanced.status, 0) << balanced.output;
+  EXPECT_NE(balanced.output.find("body 'arm_left_1_link': repaired: smallest principal moment 0.00155679 "
+                                 "raised to 0.00179767 = I₃ − I₂"),
+            std::string::npos)
+      << balanced.output;
+  EXPECT_EQ(balanced.output.find("violate"), std::string::npos) << balanced.output;
+  const Result negative = sh("info " + arm + " --bound-inertia -1");
+  EXPECT_EQ(negative.status, 2);
+  EXPECT_NE(negative.output.find("option --bound-inertia must be ≥ 0"), std::string::npos) << negative.output;
+  const Result leaf = sh("info " + std::string(APPELL_SOURCE_DIR) + "/tests/data/io/inertia/massless_leaf.urdf");
+  EXPECT_EQ(leaf.status, 1);
+  EXPECT_NE(leaf.output.find("joint 'palm_joint' (revolute) moves no inertia"), std::string::npos) << leaf.output;
+}

@@ -122,26 +122,59 @@ TEST(CoreErrors, MasslessBodyWhoseMotionMeetsNoInertia) {
   }
 }
 
+/// Builds with notes; returns them.
+std::vector<std::string> notesOf(const std::function<void(ArmSpec&)>& edit) {
+  ModelBuilder b;
+  b.addBody("base", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), good());
+  ArmSpec s;
+  edit(s);
+  b.addBody("arm", s.parent, s.placement, s.type, s.axis, s.inertia);
+  std::vector<std::string> notes;
+  b.build(&notes);
+  return notes;
+}
+
+// A massless rotor with rotational inertia (a motor's reflected inertia) is a
+// positive semi-definite spatial inertia: it runs where its joint's motion
+// meets inertia — fixed to a massive body, or turning about an axis it has a
+// moment about — and is refused on a prismatic joint, whose motion it does not resist.
 TEST(CoreErrors, ZeroMassWithRotationalInertia) {
-  expectError([](ArmSpec& s) { s.inertia.mass = 0; s.type = JointType::Fixed; },
-              {"'arm'", "zero mass but non-zero rotational inertia"});
+  EXPECT_TRUE(notesOf([](ArmSpec& s) { s.inertia.mass = 0; s.type = JointType::Fixed; }).empty());
+  const auto notes = notesOf([](ArmSpec& s) { s.inertia.mass = 0; });
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("body 'arm': massless"), std::string::npos) << notes[0];
+  expectError([](ArmSpec& s) { s.inertia.mass = 0; s.type = JointType::Prismatic; },
+              {"'arm'", "joint 'arm_joint' (prismatic) moves no inertia", "have zero mass"});
 }
 
-TEST(CoreErrors, InertiaNotPositiveDefinite) {
+TEST(CoreErrors, InertiaNotPositiveSemiDefinite) {
   expectError([](ArmSpec& s) { s.inertia.inertia_com = Vec3(0.2, -0.3, 0.4).asDiagonal(); },
-              {"'arm'", "not positive definite"});
-  expectError([](ArmSpec& s) { s.inertia.inertia_com = Vec3(0.2, 0.0, 0.2).asDiagonal(); },
-              {"'arm'", "not positive definite"});
+              {"'arm'", "not positive semi-definite", "principal moments -0.3 0.2 0.4"});
+  // Round-off below zero is zero: a flat body, singular but carried by its
+  // joint (the zero moment is about y, the joint turns about z).
+  const auto notes = notesOf([](ArmSpec& s) { s.inertia.inertia_com = Vec3(0.2, -1e-18, 0.2).asDiagonal(); });
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("body 'arm': singular inertia (mass 1 kg, principal moments -1e-18 0.2 0.2)"),
+            std::string::npos)
+      << notes[0];
+  // About its zero moment's axis, with the centre of mass on it, nothing resists.
+  expectError([](ArmSpec& s) {
+    s.inertia.inertia_com = Vec3(0.2, 0.0, 0.2).asDiagonal();
+    s.inertia.com.setZero();
+    s.axis = Vec3::UnitY();
+  }, {"'arm'", "moves no inertia", "singular"});
 }
 
-TEST(CoreErrors, TriangleInequality) {
+TEST(CoreErrors, TriangleInequalityIsANote) {
   // Rotated, so the check must work on principal moments, not the diagonal.
-  expectError(
-      [](ArmSpec& s) {
-        const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
-        s.inertia.inertia_com = R * Vec3(1.0, 1.0, 2.5).asDiagonal() * R.transpose();
-      },
-      {"'arm'", "triangle inequality"});
+  const auto notes = notesOf([](ArmSpec& s) {
+    const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    s.inertia.inertia_com = R * Vec3(1.0, 1.0, 2.5).asDiagonal() * R.transpose();
+  });
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("body 'arm': principal moments 1 1 2.5 violate the triangle inequality by 20 %"),
+            std::string::npos)
+      << notes[0];
 }
 
 TEST(CoreErrors, AsymmetricInertia) {

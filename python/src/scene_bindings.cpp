@@ -58,10 +58,20 @@ VecX sceneTau(const Scene& scene) {
 
 namespace {
 
+// The inertia repairs as keywords (None: the scene's <simulation> decides).
+struct InertiaKeywords {
+  std::optional<bool> balance;
+  std::optional<double> bound_inertia, bound_mass;
+};
+
 LoadOptions loadOptions(const std::vector<std::string>& package_paths, bool use_ros_package_path,
                         bool load_meshes, bool check_initial_state, bool project_initial_state,
-                        bool joint_limits, double initial_state_tolerance) {
+                        bool joint_limits, double initial_state_tolerance,
+                        const InertiaKeywords& inertia) {
   LoadOptions o;
+  o.balance_inertia = inertia.balance;
+  o.bound_inertia = inertia.bound_inertia;
+  o.bound_mass = inertia.bound_mass;
   o.package_paths = package_paths;
   o.use_ros_package_path = use_ros_package_path;
   o.load_meshes = load_meshes;
@@ -278,31 +288,42 @@ void bindScene(py::module_& m) {
 
   m.def("load_scene", [](py::handle path, const std::vector<std::string>& package_paths,
                          bool use_ros_package_path, bool load_meshes, bool check_initial_state,
-                         bool project_initial_state, bool joint_limits, double tol) {
+                         bool project_initial_state, bool joint_limits, double tol,
+                         std::optional<bool> balance, std::optional<double> bound_inertia,
+                         std::optional<double> bound_mass) {
         const std::string p = fspath(path);
         const LoadOptions o = loadOptions(package_paths, use_ros_package_path, load_meshes,
-                                          check_initial_state, project_initial_state, joint_limits, tol);
+                                          check_initial_state, project_initial_state, joint_limits, tol,
+                                          {balance, bound_inertia, bound_mass});
         py::gil_scoped_release release;
         return std::make_shared<Scene>(loadScene(p, o));
       }, "path"_a, py::kw_only(), "package_paths"_a = std::vector<std::string>{},
         "use_ros_package_path"_a = true, "load_meshes"_a = true, "check_initial_state"_a = true,
         "project_initial_state"_a = false, "joint_limits"_a = true,
-        "initial_state_tolerance"_a = 1e-8,
-        "Loads a URDF with an <appell> block. Raises SceneError naming the file, line and reason.");
+        "initial_state_tolerance"_a = 1e-8, "balance_inertia"_a = py::none(),
+        "bound_inertia"_a = py::none(), "bound_mass"_a = py::none(),
+        "Loads a URDF with an <appell> block. Raises SceneError naming the file, line and reason.\n"
+        "balance_inertia, bound_inertia (kg m^2), bound_mass (kg): inertia repairs as MuJoCo's\n"
+        "compiler options; None leaves the scene's <simulation> attribute in force. Repaired\n"
+        "bodies and inertias loaded with a defect are listed in Scene.warnings.");
   m.def("load_scene_from_string", [](const std::string& xml, py::handle base_dir, const std::string& name,
                                      const std::vector<std::string>& package_paths,
                                      bool use_ros_package_path, bool load_meshes, bool check_initial_state,
-                                     bool project_initial_state, bool joint_limits, double tol) {
+                                     bool project_initial_state, bool joint_limits, double tol,
+                                     std::optional<bool> balance, std::optional<double> bound_inertia,
+                                     std::optional<double> bound_mass) {
         const std::string dir = fspath(base_dir);
         const LoadOptions o = loadOptions(package_paths, use_ros_package_path, load_meshes,
-                                          check_initial_state, project_initial_state, joint_limits, tol);
+                                          check_initial_state, project_initial_state, joint_limits, tol,
+                                          {balance, bound_inertia, bound_mass});
         py::gil_scoped_release release;
         return std::make_shared<Scene>(loadSceneFromString(xml, dir, name, o));
       }, "xml"_a, "base_dir"_a = ".", "name"_a = "<string>", py::kw_only(),
         "package_paths"_a = std::vector<std::string>{}, "use_ros_package_path"_a = true,
         "load_meshes"_a = true, "check_initial_state"_a = true, "project_initial_state"_a = false,
-        "joint_limits"_a = true, "initial_state_tolerance"_a = 1e-8,
-        "Loads a scene from URDF text; base_dir resolves relative mesh paths.");
+        "joint_limits"_a = true, "initial_state_tolerance"_a = 1e-8, "balance_inertia"_a = py::none(),
+        "bound_inertia"_a = py::none(), "bound_mass"_a = py::none(),
+        "Loads a scene from URDF text; base_dir resolves relative mesh paths (keywords as load_scene).");
 
   m.def("integrators", [] { return nameTable(integratorTable()); },
         "Integrator names, aliases and descriptions.");

@@ -230,6 +230,27 @@ def test_missing_visual_mesh_is_a_warning(tmp_path):
     assert appell.load_scene(DISK).warnings == []
 
 
+def test_inertia_repairs_as_keywords(tmp_path):
+    # The CAD export of TIAGo's arm_left_1_link on a floating base: moments
+    # 0.00155679 0.00597627 0.00777394 break the triangle inequality by 3.1 %.
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(
+        "<robot name='r'><link name='arm_left_1_link'><inertial><mass value='1.563428'/>"
+        "<inertia ixx='0.002471' ixy='0.001809' ixz='-0.001202' iyy='0.006132' iyz='-0.000494' "
+        "izz='0.006704'/></inertial></link></robot>")
+    plain = appell.load_scene(urdf)
+    assert len(plain.warnings) == 1
+    assert "violate the triangle inequality by 3.09" in plain.warnings[0]
+    balanced = appell.load_scene(urdf, balance_inertia=True)
+    assert len(balanced.warnings) == 1
+    assert "repaired: smallest principal moment 0.00155679 raised to 0.00179767" in balanced.warnings[0]
+    bounded = appell.load_scene_from_string(urdf.read_text(), name="arm.urdf", bound_mass=2.0)
+    assert "mass 1.56343 kg raised to 2 (bound mass)" in bounded.warnings[0]
+    assert bounded.total_mass == 2.0 and plain.total_mass == 1.563428
+    with pytest.raises(appell.SceneError, match="must be finite and"):
+        appell.load_scene(urdf, bound_inertia=-1.0)
+
+
 def test_mimic_coupling_reaction(tmp_path):
     # A gear pair: the follower (inertia 0.08) turns at −0.4 × the leader
     # (0.02) under 0.3 N·m on the leader; the coupling's torque on the

@@ -105,13 +105,40 @@ struct ModelError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Opt-in repairs of inertias as CAD tools and robot vendors publish them,
+/// with the semantics of MuJoCo's compiler options of the same names, applied
+/// to each rigid group (a moving body with the bodies fixed to it, as MuJoCo
+/// applies them after fusing static bodies) in this order:
+///   bound_mass     a group's mass is raised to at least this (kg); the added
+///                  mass sits at the group's centre of mass (at the body's
+///                  origin when it had none);
+///   bound_inertia  each principal moment about the group's centre of mass is
+///                  raised to at least this (kg m²);
+///   balance        when the principal moments I₁ ≤ I₂ ≤ I₃ break the triangle
+///                  inequality, I₁ is raised to I₃ − I₂, keeping the axes and
+///                  the two larger moments (MuJoCo's balanceinertia replaces
+///                  all three by their mean instead: a larger change).
+/// The correction is added to the moving body's own inertia; each repaired
+/// group gets one note naming the body and what changed.
+struct InertiaRepairs {
+  bool balance = false;
+  double bound_inertia = 0;
+  double bound_mass = 0;
+  bool any() const { return balance || bound_inertia > 0 || bound_mass > 0; }
+};
+
 /// Builds a Model body by body. `build()` validates everything and throws
-/// ModelError naming the body and the reason: finite numbers, no negative
-/// mass, unit axes, and for every moving body the combined inertia of its
-/// rigid group (itself and the bodies fixed to it, rigidGroups) positive
-/// definite and satisfying the triangle inequality, or massless with massive
-/// bodies beyond its joint. A body on a fixed joint may be massless or
-/// degenerate (a point mass, a sensor frame): only its group is judged.
+/// ModelError naming the body and the reason for what the dynamics cannot
+/// run: non-finite numbers, a negative mass, a zero axis, a rotational
+/// inertia that is not symmetric or has a negative principal moment beyond
+/// round-off, and a joint whose articulated inertia along its motion
+/// (D = Sᵀ Iᴬ S, Featherstone 2008, §7.3) is singular — the mass matrix would
+/// be. Inertias the dynamics can run although no mass distribution has them —
+/// principal moments that break the triangle inequality (CAD rounding), a
+/// massless or singular group carried by bodies that give its joint full
+/// rank (a near-massless floating base) — load, with one note per group in
+/// `notes`. A body on a fixed joint may be massless or degenerate (a point
+/// mass, a sensor frame): only its rigid group (rigidGroups) is judged.
 class ModelBuilder {
  public:
   /// Adds a body attached to `parent` (−1 = world) by `joint`, whose frame sits
@@ -120,7 +147,10 @@ class ModelBuilder {
               const Vec3& axis, const Inertia& inertia, const std::string& joint_name = "",
               const JointLimits& limits = {});
   void setGravity(const Vec3& g) { gravity_ = g; }
-  Model build() const;
+  void setInertiaRepairs(const InertiaRepairs& r) { repairs_ = r; }
+  /// The model; when `notes` is given, one line per rigid group loaded with a
+  /// defect or repaired, "body 'NAME': …" (appended).
+  Model build(std::vector<std::string>* notes = nullptr) const;
 
  private:
   struct Entry {
@@ -134,6 +164,7 @@ class ModelBuilder {
   };
   std::vector<Entry> entries_;
   Vec3 gravity_{0, 0, -9.81};
+  InertiaRepairs repairs_;
 };
 
 }  // namespace appell

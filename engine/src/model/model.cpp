@@ -1,14 +1,10 @@
+// The kinematic tree's small queries, and ModelBuilder: the structure checked body by
+// body; the inertias judged and repaired per rigid group in inertia_check.cpp.
 #include <appell/model.hpp>
 
-#include <appell/configuration.hpp>
-#include <appell/data.hpp>
-#include <appell/dynamics.hpp>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
+#include "model/inertia_check.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <string_view>
 #include <unordered_set>
 
@@ -89,89 +85,24 @@ bool finite(const Eigen::MatrixBase<Derived>& m) {
   return m.allFinite();
 }
 
-// Rotational inertia about the centre of mass must be symmetric positive
-// definite and its principal moments must satisfy the triangle inequality
-// (I₁ + I₂ ≥ I₃): otherwise no mass distribution has it.
-void checkInertia(const std::string& body, const Inertia& I, bool may_be_massless) {
-  if (!std::isfinite(I.mass) || !finite(I.com) || !finite(I.inertia_com))
-    fail(body, "inertia has a non-finite value");
-  if (I.mass < 0) fail(body, "negative mass " + std::to_string(I.mass));
-  if (I.mass == 0) {
-    if (!may_be_massless) fail(body, "zero mass on a moving body with no massive descendants");
-    if (I.inertia_com.norm() != 0) fail(body, "zero mass but non-zero rotational inertia");
-    return;
-  }
-  const Mat3& J = I.inertia_com;
-  if ((J - J.transpose()).norm() > 1e-9 * (1 + J.norm())) fail(body, "inertia tensor is not symmetric");
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(J);
-  const Vec3 d = eig.eigenvalues();
-  const double tol = 1e-12 * std::max(1.0, d.cwiseAbs().maxCoeff());
-  if (d.minCoeff() <= 0) {
-    std::ostringstream s;
-    s << "inertia tensor is not positive definite (principal moments " << d.transpose() << ")";
-    fail(body, s.str());
-  }
-  if (d(0) + d(1) < d(2) - tol) {
-    std::ostringstream s;
-    s << "principal moments " << d.transpose() << " violate the triangle inequality";
-    fail(body, s.str());
-  }
-}
-
-// A massless moving body is harmless only when the bodies it carries give every
-// direction of its joint some inertia. Otherwise M is singular — e.g. a
-// massless floating frame carrying a wheel on a revolute joint: frame and wheel
-// can counter-rotate at no cost — and ABA would return huge numbers instead of
-// an error. The joint-space articulated inertia D = Sᵀ Iᴬ S (Featherstone 2008,
-// §7.3) of each such body must be positive definite; it is read off one ABA
-// pass at the neutral and at two random configurations.
-void checkMasslessJoints(const Model& m) {
-  bool any = false;
-  for (int i = 0; i < m.nbodies; ++i) any |= m.joints[i].nv > 0 && m.inertias[i].mass == 0;
-  if (!any) return;
-  Data data(m);
-  std::mt19937 rng(12345);
-  const VecX zero = VecX::Zero(m.nv);
-  for (int trial = 0; trial < 3; ++trial) {
-    const VecX q = trial == 0 ? neutralConfiguration(m) : randomConfiguration(m, rng);
-    aba(m, data, q, zero, zero);
-    for (int i = 0; i < m.nbodies; ++i) {
-      const Joint& j = m.joints[i];
-      if (j.nv == 0 || m.inertias[i].mass != 0) continue;
-      const MatX D = j.S.transpose() * data.IA[i] * j.S;
-      const Eigen::SelfAdjointEigenSolver<MatX> eig(D);
-      const double scale = std::max(1e-300, data.IA[i].norm());
-      if (eig.eigenvalues().minCoeff() <= 1e-12 * scale)
-        fail(m.body_names[i],
-             "massless body on a moving joint whose motion meets no inertia (the bodies it "
-             "carries can move so as to cancel it): the mass matrix would be singular");
-    }
-  }
-}
-
 }  // namespace
 
-Model ModelBuilder::build() const {
+Model ModelBuilder::build(std::vector<std::string>* notes) const {
   Model m;
   const int n = static_cast<int>(entries_.size());
   m.nbodies = n;
   m.gravity = gravity_;
   if (!gravity_.allFinite()) throw ModelError("gravity is not finite");
   m.children.resize(n);
-  // Every body's own numbers first: the subtree masses below would otherwise
-  // turn one body's negative or NaN mass into a misleading error about another
-  // body (a parent whose subtree "carries no mass").
+  // Every body's own numbers first: a rigid group's or a subtree's sums would
+  // otherwise turn one body's negative or NaN mass into a misleading error
+  // about another body.
   for (const Entry& e : entries_) {
     if (!std::isfinite(e.inertia.mass) || !finite(e.inertia.com) || !finite(e.inertia.inertia_com))
       fail(e.name, "inertia has a non-finite value");
-    if (e.inertia.mass < 0) fail(e.name, "negative mass " + std::to_string(e.inertia.mass));
-  }
-  // Subtree mass decides whether a massless body is acceptable: a moving joint
-  // needs something with inertia beyond it.
-  std::vector<double> subtree_mass(n, 0.0);
-  for (int i = n - 1; i >= 0; --i) {
-    subtree_mass[i] += entries_[i].inertia.mass;
-    if (entries_[i].parent >= 0 && entries_[i].parent < i) subtree_mass[entries_[i].parent] += subtree_mass[i];
+    if (e.inertia.mass < 0)
+      fail(e.name, "negative mass " + std::to_string(e.inertia.mass) +
+                       ": write a mass ≥ 0 (0 for a frame that carries none)");
   }
   std::unordered_set<std::string_view> body_names;  // one pass, not every pair
   body_names.reserve(static_cast<std::size_t>(n));
@@ -183,11 +114,6 @@ Model ModelBuilder::build() const {
     if (!finite(e.placement.R) || !finite(e.placement.p)) fail(e.name, "joint placement is not finite");
     if ((e.placement.R.transpose() * e.placement.R - Mat3::Identity()).norm() > 1e-9)
       fail(e.name, "joint placement rotation is not orthonormal");
-    const bool moving = e.type != JointType::Fixed;
-    if (moving && subtree_mass[i] <= 0)
-      fail(e.name, "zero mass on a moving body with no massive descendants (its joint carries no mass)");
-    if (e.inertia.mass == 0 && e.inertia.inertia_com.norm() != 0)
-      fail(e.name, "zero mass but non-zero rotational inertia");
 
     Joint j;
     j.type = e.type;
@@ -228,10 +154,9 @@ Model ModelBuilder::build() const {
     m.placement.push_back(e.placement);
     m.joints.push_back(j);
     m.inertias.push_back(e.inertia);
-    m.spatial_inertia.push_back(e.inertia.matrix());
-    const Eigen::LLT<Mat6> llt(m.spatial_inertia.back());
-    m.spatial_inertia_factor.push_back(llt.info() == Eigen::Success ? Mat6(llt.matrixL())
-                                                                    : Mat6::Zero());
+    m.spatial_inertia.emplace_back();
+    m.spatial_inertia_factor.emplace_back();
+    detail::cacheSpatialInertia(m, i);
     m.body_names.push_back(e.name);
     m.joint_names.push_back(e.joint_name);
     if (e.parent >= 0) m.children[e.parent].push_back(i);
@@ -245,24 +170,14 @@ Model ModelBuilder::build() const {
     if (!joint_names.insert(m.joint_names[i]).second)
       fail(m.body_names[i], "joint name '" + m.joint_names[i] + "' is used twice");
   // The mass distribution is judged per rigid group (a moving body with the
-  // bodies fixed to it), as the dynamics see it: a sensor frame or a point
-  // mass on a fixed joint is fine when its group is a valid rigid body.
-  for (const RigidGroup& g : rigidGroups(m)) {
-    std::string name = m.body_names[g.body];
-    std::string merged;
-    for (int f : g.fixed)
-      if (m.inertias[f].mass > 0 || m.inertias[f].inertia_com.norm() > 0)
-        merged += (merged.empty() ? "'" : ", '") + m.body_names[f] + "'";
-    try {
-      checkInertia(name, g.inertia, subtree_mass[g.body] > 0);
-    } catch (const ModelError& err) {
-      if (merged.empty()) throw;
-      const std::string what = err.what(), head = "body '" + name + "': ";
-      fail(name, "combined inertia with the fixed " + merged + " (merged as ROS tools do): " +
-                     what.substr(what.rfind(head, 0) == 0 ? head.size() : 0));
-    }
-  }
-  checkMasslessJoints(m);
+  // bodies fixed to it), as the dynamics see it, after the repairs the caller
+  // asked for (inertia_check.cpp).
+  std::vector<std::string> per_body(static_cast<std::size_t>(n));
+  detail::repairInertias(m, repairs_, per_body);
+  detail::checkInertias(m, per_body);
+  if (notes)
+    for (int i = 0; i < n; ++i)
+      if (!per_body[i].empty()) notes->push_back("body '" + m.body_names[i] + "': " + per_body[i]);
   return m;
 }
 

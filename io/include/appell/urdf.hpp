@@ -20,6 +20,7 @@
 
 #include <appell/scene.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,13 @@ struct LoadOptions {
   /// Scene::warnings (rpy="-1.57" is a wheel 7.96e-4 rad off its axle: a
   /// rigid model takes it literally). At most 0.05 rad.
   double snap_angles = 0;
+  /// Repairs of inertias as published (InertiaRepairs, model.hpp; MuJoCo's
+  /// balanceinertia, boundinertia, boundmass): each one set here overrides
+  /// the scene's <simulation balance_inertia bound_inertia bound_mass>; left
+  /// unset, the scene's applies (none by default). Every repaired body gets a
+  /// line in Scene::warnings.
+  std::optional<bool> balance_inertia;
+  std::optional<double> bound_inertia, bound_mass;
 };
 
 /// Model only (links, joints, inertias, limits, gravity from the `<appell>`

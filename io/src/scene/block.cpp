@@ -347,7 +347,8 @@ ActuatorDecl parseActuator(const XmlSource& src, const TiXmlElement* e) {
 }
 
 SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
-  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation", "snap_angles"});
+  allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation", "snap_angles",
+                     "balance_inertia", "bound_inertia", "bound_mass"});
   SimulationSettings s;
   // Both names are stored canonical ("multipliers" reads as "kkt").
   try {
@@ -366,6 +367,21 @@ SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) 
                    "π/2 are design, not rounding");
   }
   return s;
+}
+
+// The inertia repairs of <simulation> (InertiaRepairs, model.hpp): a flag and
+// two bounds ≥ 0 (kg m², kg).
+InertiaRepairs parseInertiaRepairs(const XmlSource& src, const TiXmlElement* e) {
+  InertiaRepairs r;
+  const std::string balance = text(e, "balance_inertia", "false");
+  if (balance != "true" && balance != "false") fail(src, e, "'balance_inertia' must be \"true\" or \"false\"");
+  r.balance = balance == "true";
+  for (auto [attr, bound] : {std::pair{"bound_inertia", &r.bound_inertia}, std::pair{"bound_mass", &r.bound_mass}}) {
+    if (!has(e, attr)) continue;
+    *bound = number(src, e, attr);
+    if (*bound < 0) fail(src, e, std::string("'") + attr + "' must be ≥ 0 (a lower bound; 0: none)");
+  }
+  return r;
 }
 
 }  // namespace
@@ -435,6 +451,7 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
       if (have_simulation) fail(src, e, "<simulation> is given twice");
       have_simulation = true;
       b.settings = parseSimulation(src, e);
+      b.repairs = parseInertiaRepairs(src, e);
     } else {
       fail(src, e, "unknown element <" + tag +
                        "> in <appell> (known: gravity, support, contact, initial, effort, actuator, joint_limits, simulation)");

@@ -77,6 +77,9 @@ struct AppellBlock {
   std::vector<EffortDecl> efforts;
   std::vector<ActuatorDecl> actuators;
   SimulationSettings settings;
+  /// <simulation balance_inertia bound_inertia bound_mass>: the scene's
+  /// inertia repairs (LoadOptions may override each).
+  InertiaRepairs repairs;
   /// <joint_limits enabled="true|false" restitution="e"/>
   const TiXmlElement* limits_element = nullptr;
   bool limits_enabled = true;

@@ -19,7 +19,8 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   const double snap = options.snap_angles > 0 ? options.snap_angles : block.settings.snap_angles;
   const std::vector<std::string> snapped = snap > 0 ? io::snapAngles(src, snap, urdf)
                                                     : std::vector<std::string>{};
-  io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity, block.collisionLinks());
+  io::Robot parsed = io::buildRobot(src, urdf, base_dir, options, block.gravity,
+                                    io::inertiaRepairs(options, block.repairs), block.collisionLinks());
   parsed.warnings.insert(parsed.warnings.begin(), snapped.begin(), snapped.end());
   Scene scene;
   scene.model = std::move(parsed.model);

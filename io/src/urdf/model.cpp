@@ -97,11 +97,20 @@ LinkGeometry resolveLinkGeometry(const XmlSource& src, const UrdfLink& link, con
 
 }  // namespace
 
+InertiaRepairs inertiaRepairs(const LoadOptions& options, const InertiaRepairs& scene) {
+  InertiaRepairs r = scene;
+  if (options.balance_inertia) r.balance = *options.balance_inertia;
+  if (options.bound_inertia) r.bound_inertia = *options.bound_inertia;
+  if (options.bound_mass) r.bound_mass = *options.bound_mass;
+  return r;
+}
+
 Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string& base_dir,
-                 const LoadOptions& options, const Vec3& gravity,
+                 const LoadOptions& options, const Vec3& gravity, const InertiaRepairs& repairs,
                  const std::set<std::string>& contact_links) {
   ModelBuilder builder;
   builder.setGravity(gravity);
+  builder.setInertiaRepairs(repairs);
   std::map<std::string, int> body_of_link;
   Robot robot;
   MeshCache cache;
@@ -140,20 +149,32 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
   }
   uri_notes.appendTo(robot.warnings);
   unused_missing.appendTo(robot.warnings);
+  std::vector<std::string> notes;
   try {
-    robot.model = builder.build();
+    robot.model = builder.build(&notes);
   } catch (const ModelError& e) {
     std::string msg = e.what();
     // ModelError names the body; the body is the link of the same name. A
     // link's own inertia is pointed at in its <inertia>; a group's combined
     // one (with fixed links merged) at the moving link.
     const bool own_inertia = msg.find("combined inertia") == std::string::npos &&
-                             (msg.find("inertia") != std::string::npos ||
+                             (msg.find("inertia tensor") != std::string::npos ||
                               msg.find("principal moments") != std::string::npos);
     for (const auto& [name, link] : urdf.links)
       if (msg.rfind("body '" + name + "'", 0) == 0)
         fail(src, own_inertia && link.inertia_element ? link.inertia_element : link.element, msg);
     fail(src, msg);
+  }
+  // Each note names its body ("body 'NAME': …"), the link of that name: the
+  // warning points at the link, as the errors do.
+  for (const std::string& note : notes) {
+    std::string where = src.file;
+    for (const auto& [name, link] : urdf.links)
+      if (note.rfind("body '" + name + "'", 0) == 0 && link.element) {
+        where += ":" + std::to_string(link.element->Row()) + ": " + describe(link.element);
+        break;
+      }
+    robot.warnings.push_back(where + ": " + note);
   }
   return robot;
 }

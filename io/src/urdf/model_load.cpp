@@ -56,11 +56,13 @@ Model loadUrdfModel(const std::string& path, const LoadOptions& options) {
   TiXmlDocument doc;
   const TiXmlElement* robot = io::parseDocument(src, doc, xml);
   const io::UrdfRobot urdf = io::readUrdf(src, robot);
-  // Only the gravity of the scene block matters for the model.
+  // Only the gravity of the scene block matters for the model (the inertia
+  // repairs are LoadOptions' alone here).
   Vec3 gravity(0, 0, -9.81);
   if (const TiXmlElement* block = robot->FirstChildElement("appell"))
     if (const TiXmlElement* g = block->FirstChildElement("gravity")) gravity = io::vec3(src, g, "xyz");
-  return io::buildRobot(src, urdf, io::folderOf(path), options, gravity).model;
+  return io::buildRobot(src, urdf, io::folderOf(path), options, gravity, io::inertiaRepairs(options, {}))
+      .model;
 }
 
 }  // namespace appell

@@ -87,13 +87,18 @@ struct Robot {
 };
 
 /// Builds the model and the link geometry (meshes resolved and, if the
-/// options say so, loaded) from what readUrdf read. A collision mesh that
+/// options say so, loaded) from what readUrdf read, with the inertias
+/// repaired as asked; each inertia loaded with a defect or repaired adds a
+/// warning "file:line: <link name=…>: body '…': …". A collision mesh that
 /// cannot be found or read is an error on the links of `contact_links` (a
 /// contact takes its shape from their collision geometry), elsewhere a
 /// warning, the geometry left out.
 Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string& base_dir,
-                 const LoadOptions& options, const Vec3& gravity,
+                 const LoadOptions& options, const Vec3& gravity, const InertiaRepairs& repairs,
                  const std::set<std::string>& contact_links = {});
+
+/// The repairs in force: each one LoadOptions sets, else the scene's.
+InertiaRepairs inertiaRepairs(const LoadOptions& options, const InertiaRepairs& scene);
 
 /// The warning a mesh URI earns when the loader tolerates its form:
 /// `package:///NAME/…` is read as `package://NAME/…`. Empty when none.

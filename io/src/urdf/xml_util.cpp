@@ -40,6 +40,13 @@ std::string clipQuoted(const std::string& reason) {
         i = end + 1;
         continue;
       }
+      // A short quoted span is kept whole: its closing quote must not open
+      // the next span (the text between two quoted names is not a value).
+      if (end != std::string::npos) {
+        out.append(reason, i, end - i + 1);
+        i = end + 1;
+        continue;
+      }
     }
     out += c;
     ++i;
