@@ -178,7 +178,7 @@ TEST(FuzzRegressions, OnlyTheFourMeshFormatsReachAnImporter) {
         << m;
   }
   EXPECT_NE(meshError("v\nfrom 0 0 5\nat 0 0 0\np 3\n0 0 0\n1 0 0\n0 1 0\n", "scene.nff")
-                .find("a text file of no format appell reads"),
+                .find("a text file of another format: not a mesh format appell reads"),
             std::string::npos);
   EXPECT_NE(meshError("AC3Db\nOBJECT world\nkids 0\n", "model.obj").find("a file starting with \"AC3D\""),
             std::string::npos);

@@ -95,7 +95,7 @@ std::string describeOther(const std::string& bytes, std::size_t i) {
     if (startsWith(bytes, i, magic)) return std::string("a file starting with \"") + magic + "\"";
   const bool binary = std::find(bytes.begin(), bytes.begin() + static_cast<long>(std::min<std::size_t>(bytes.size(), 4096)),
                                 '\0') != bytes.begin() + static_cast<long>(std::min<std::size_t>(bytes.size(), 4096));
-  return binary ? "a binary file of no format appell reads" : "a text file of no format appell reads";
+  return binary ? "a binary file of another format" : "a text file of another format";
 }
 
 MeshFormat sniff(const std::string& path, const std::string& bytes) {
