@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -160,9 +161,21 @@ void checkPlyHeader(const std::string& path, const std::string& bytes) {
       throw SceneError(path + ":" + std::to_string(lineAt(bytes, k)) +
                        ": the PLY header holds a byte that is not ASCII text: the file is damaged");
   }
-  static const std::set<std::string> kTypes = {"char",  "uchar",  "short",  "ushort",  "int",    "uint",
-                                               "float", "double", "int8",   "uint8",   "int16",  "uint16",
-                                               "int32", "uint32", "float32", "float64"};
+  // "end_header" alone on its line: what follows it is the data (a binary
+  // body read from a misplaced start crashed assimp's reader).
+  const std::size_t data = end + 11;
+  const bool crlf = bytes.compare(data, 2, "\r\n") == 0;
+  if (!crlf && bytes.compare(data, 1, "\n") != 0)
+    throw SceneError(path + ":" + std::to_string(lineAt(bytes, data)) +
+                     ": PLY header: 'end_header' must end its line: the file is damaged");
+  const std::size_t body = data + (crlf ? 2 : 1);
+  static const std::map<std::string, int> kTypes = {
+      {"char", 1},  {"uchar", 1},  {"short", 2},  {"ushort", 2},  {"int", 4},     {"uint", 4},
+      {"float", 4}, {"double", 8}, {"int8", 1},   {"uint8", 1},   {"int16", 2},   {"uint16", 2},
+      {"int32", 4}, {"uint32", 4}, {"float32", 4}, {"float64", 8}};
+  bool binary = false;
+  std::uintmax_t least = 0, count = 0;  // bytes the declared elements need at least (binary)
+
   std::istringstream header(bytes.substr(0, end));
   std::string line;
   bool element_seen = false;
@@ -182,21 +195,27 @@ void checkPlyHeader(const std::string& path, const std::string& bytes) {
     } else if (w[0] == "format") {
       if (w.size() != 3 || (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
         bad("not 'format ascii|binary_little_endian|binary_big_endian VERSION'");
+      binary = w[1] != "ascii";
     } else if (w[0] == "element") {
       const bool digits = w.size() == 3 && w[2].size() <= 19 &&
                           std::all_of(w[2].begin(), w[2].end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
       if (!digits) bad("not 'element NAME COUNT'");
       if (std::stoull(w[2]) > bytes.size()) bad("more elements than the file could hold");
+      count = std::stoull(w[2]);
       element_seen = true;
     } else if (w[0] == "property") {
       const bool scalar = w.size() == 3 && kTypes.count(w[1]);
       const bool list = w.size() == 5 && w[1] == "list" && kTypes.count(w[2]) && kTypes.count(w[3]);
       if (!scalar && !list) bad("not 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
       if (!element_seen) bad("a property before any element");
+      least += count * static_cast<std::uintmax_t>(kTypes.at(list ? w[2] : w[1]));  // a list: its count
     } else {
       bad("not a PLY header keyword");
     }
   }
+  if (binary && least > bytes.size() - body)
+    throw SceneError(path + ": the PLY header declares at least " + std::to_string(least) + " bytes of data, the file has " +
+                     std::to_string(bytes.size() - body) + ": the file is damaged (cut short?)");
 }
 
 MeshFile readMeshFile(const std::string& path) {
