@@ -7,6 +7,7 @@
 #include <appell/urdf.hpp>
 
 #include "run_command.hpp"
+#include "scene_helpers.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,6 +3,8 @@
 #include <appell/overloaded.hpp>
 #include <appell/vertex_contacts.hpp>
 
+#include <Eigen/Eigenvalues>
+
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
@@ -58,14 +60,34 @@ std::vector<int> supportPoints(const std::vector<Vec3>& points, const std::vecto
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     const Vec3 d(r * std::cos(k * golden_angle), r * std::sin(k * golden_angle), z);
     std::size_t best = 0;
-    for (std::size_t i = 1; i < hull.size(); ++i)
-      if (d.dot(points[hull[i]]) > d.dot(points[hull[best]])) best = i;
+    double farthest = d.dot(points[hull[0]]);
+    for (std::size_t i = 1; i < hull.size(); ++i) {
+      const double reach = d.dot(points[hull[i]]);
+      if (reach > farthest) best = i, farthest = reach;
+    }
     kept[best] = 1;
   }
   std::vector<int> out;
   for (std::size_t i = 0; i < hull.size(); ++i)
     if (kept[i]) out.push_back(hull[i]);
   return out;
+}
+
+// Meshes with more vertices skip Qhull (see contactVertices).
+constexpr std::size_t kQhullVertices = 20000;
+
+// The support points must span a volume, as Qhull requires of the hull
+// (their covariance's smallest eigenvalue not below 10⁻¹² of its largest).
+void requireVolume(const std::vector<Vec3>& points, const std::vector<int>& ids, const std::string& what) {
+  Vec3 mean = Vec3::Zero();
+  for (int i : ids) mean += points[i];
+  mean /= static_cast<double>(ids.size());
+  Mat3 cov = Mat3::Zero();
+  for (int i : ids) cov += (points[i] - mean) * (points[i] - mean).transpose();
+  const Vec3 eig = Eigen::SelfAdjointEigenSolver<Mat3>(cov, Eigen::EigenvaluesOnly).eigenvalues();
+  if (!(eig[0] > 1e-12 * eig[2]))
+    throw std::invalid_argument(what + ": its vertices span no volume (a flat or degenerate "
+                                       "mesh has no convex hull to touch with)");
 }
 
 }  // namespace
@@ -97,10 +119,23 @@ std::vector<Vec3> contactVertices(const Shape& shape, int rim_points, int* hull_
           },
           [&](const Mesh& m) {
             if (m.triangles.empty()) return refuse("mesh '" + m.file + "': its triangles were not loaded");
-            std::vector<int> hull = hullVertexIndices(m.vertices, "mesh '" + m.file + "'");
-            if (static_cast<int>(hull.size()) > kMaxHullContacts) {
-              if (hull_vertices) *hull_vertices = static_cast<int>(hull.size());
+            std::vector<int> hull;
+            if (m.vertices.size() > kQhullVertices) {
+              // The farthest point along a direction is a hull vertex: the
+              // support points come straight from all the vertices, O(K n),
+              // without the hull (Qhull on 1.8·10⁵ points on a sphere takes
+              // seconds).
+              hull.resize(m.vertices.size());
+              for (std::size_t i = 0; i < hull.size(); ++i) hull[i] = static_cast<int>(i);
               hull = supportPoints(m.vertices, hull);
+              requireVolume(m.vertices, hull, "mesh '" + m.file + "'");
+              if (hull_vertices) *hull_vertices = static_cast<int>(m.vertices.size());
+            } else {
+              hull = hullVertexIndices(m.vertices, "mesh '" + m.file + "'");
+              if (static_cast<int>(hull.size()) > kMaxHullContacts) {
+                if (hull_vertices) *hull_vertices = static_cast<int>(m.vertices.size());
+                hull = supportPoints(m.vertices, hull);
+              }
             }
             std::vector<Vec3> out;
             for (int id : hull) out.push_back(m.pose.apply(m.vertices[id]));
@@ -129,7 +164,8 @@ std::vector<std::shared_ptr<ShapeContact>> makeVertexContacts(const ContactSpec&
     int hull_vertices = 0;
     vertices = contactVertices(spec.shape, rim_points, &hull_vertices);
     if (hull_vertices > 0 && warning)
-      *warning = "contact '" + name + "': the mesh's convex hull has " + std::to_string(hull_vertices) +
+      *warning = "contact '" + name + "': the mesh's convex hull has more than " +
+                 std::to_string(kMaxHullContacts) + " of its " + std::to_string(hull_vertices) +
                  " vertices; its " + std::to_string(vertices.size()) + " support points in " +
                  std::to_string(kMaxHullContacts) + " evenly spread directions are the contacts";
   } catch (const std::invalid_argument& e) {

@@ -28,26 +28,46 @@ namespace {
 [[noreturn]] void throwNonFiniteVertex(const std::string& path, const aiMesh& mesh, unsigned i,
                                        const Vec3& placed) {
   const aiVector3D& raw = mesh.mVertices[i];
-  char text[160];
-  std::snprintf(text, sizeof text, "vertex %u of mesh '%s' is (%g, %g, %g)", i, mesh.mName.C_Str(),
-                static_cast<double>(raw.x), static_cast<double>(raw.y), static_cast<double>(raw.z));
-  std::string why = text;
+  char coordinates[96];
+  std::snprintf(coordinates, sizeof coordinates, "(%g, %g, %g)", static_cast<double>(raw.x),
+                static_cast<double>(raw.y), static_cast<double>(raw.z));
+  std::string why = "vertex " + std::to_string(i) + " of mesh '" + mesh.mName.C_Str() + "' is " + coordinates;
   if (std::isfinite(raw.x) && std::isfinite(raw.y) && std::isfinite(raw.z))
     why += " and (" + std::to_string(placed.x()) + ", " + std::to_string(placed.y()) + ", " +
            std::to_string(placed.z()) + ") once placed and scaled";
   throw SceneError(path + ": " + why + ": a mesh vertex must be finite");
 }
 
-// Polygons of more than kMaxFaceCorners corners, refused before assimp
-// triangulates them (ear clipping, quadratic in the corners).
-void checkFaceSizes(const std::string& path, const aiScene& scene) {
+// Every face checked before assimp's post-processing reads it: 1 to
+// kMaxFaceCorners corners (its ear clipping is quadratic in them), each
+// naming a vertex the mesh has (the triangulation reads the positions: an
+// index past them was a segfault), and the mesh's primitive types recomputed
+// from its faces (an importer that sets them wrong, or not at all, reached
+// an ai_assert abort in the triangulation: PLY, NFF and AC3D files the mesh
+// fuzzer made). The scene is the importer's own; it is fixed in place.
+void checkFaces(const std::string& path, const aiScene& scene) {
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh& mesh = *scene.mMeshes[m];
-    for (unsigned f = 0; f < mesh.mNumFaces; ++f)
-      if (mesh.mFaces[f].mNumIndices > io::kMaxFaceCorners)
-        throw SceneError(path + ": face " + std::to_string(f) + " of mesh '" + mesh.mName.C_Str() + "' has " +
-                         std::to_string(mesh.mFaces[f].mNumIndices) + " corners (at most " +
-                         std::to_string(io::kMaxFaceCorners) + " are triangulated)");
+    aiMesh& mesh = *scene.mMeshes[m];
+    const std::string where = path + ": mesh '" + mesh.mName.C_Str() + "'";
+    if (mesh.mNumVertices > 0 && !mesh.mVertices) throw SceneError(where + " has no vertex positions");
+    unsigned types = 0;
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices == 0 || !face.mIndices)
+        throw SceneError(where + ": face " + std::to_string(f) + " has no corners: the file is damaged");
+      if (face.mNumIndices > io::kMaxFaceCorners)
+        throw SceneError(where + ": face " + std::to_string(f) + " has " + std::to_string(face.mNumIndices) +
+                         " corners (at most " + std::to_string(io::kMaxFaceCorners) + " are triangulated)");
+      for (unsigned c = 0; c < face.mNumIndices; ++c)
+        if (face.mIndices[c] >= mesh.mNumVertices)
+          throw SceneError(path + ": face " + std::to_string(f) + " names vertex " + std::to_string(face.mIndices[c]) +
+                           " but the mesh has " + std::to_string(mesh.mNumVertices) + " vertices");
+      types |= face.mNumIndices == 1   ? aiPrimitiveType_POINT
+               : face.mNumIndices == 2 ? aiPrimitiveType_LINE
+               : face.mNumIndices == 3 ? aiPrimitiveType_TRIANGLE
+                                       : aiPrimitiveType_POLYGON;
+    }
+    mesh.mPrimitiveTypes = types;
   }
 }
 
@@ -63,7 +83,7 @@ const aiScene* importMesh(Assimp::Importer& importer, const std::string& path) {
   const aiScene* scene =
       importer.ReadFileFromMemory(file.bytes.data(), file.bytes.size(), 0, io::assimpHint(file.format));
   if (scene && scene->mRootNode) {
-    checkFaceSizes(path, *scene);
+    checkFaces(path, *scene);
     scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_SortByPType);
   }
   if (!scene || !scene->mRootNode) {

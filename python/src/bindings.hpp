@@ -30,4 +30,11 @@ int bodyIndex(const Scene& scene, py::handle which);
 /// The scene's constant joint forces when it has them (size nv), else empty.
 VecX sceneTau(const Scene& scene);
 
+/// Names and messages as Python text: UTF-8, any byte that is not (a link
+/// name or a path in another encoding) shown as \xNN instead of making the
+/// conversion itself fail (a UnicodeDecodeError from body_names, an empty
+/// SceneError message).
+py::str pythonText(const std::string& text);
+py::list pythonTexts(const std::vector<std::string>& texts);
+
 }  // namespace appell::python

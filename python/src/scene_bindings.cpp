@@ -151,40 +151,40 @@ void bindScene(py::module_& m) {
       .def_property_readonly("nv", [](const Scene& s) { return s.model.nv; })
       .def_property_readonly("nbodies", [](const Scene& s) { return s.model.nbodies; })
       .def_property_readonly("nrows", &Scene::constraintRows, "Total constraint rows (size of λ).")
-      .def_property_readonly("body_names", [](const Scene& s) { return s.model.body_names; })
-      .def_property_readonly("joint_names", [](const Scene& s) { return s.model.joint_names; })
+      .def_property_readonly("body_names", [](const Scene& s) { return pythonTexts(s.model.body_names); })
+      .def_property_readonly("joint_names", [](const Scene& s) { return pythonTexts(s.model.joint_names); })
       .def_property_readonly("joint_types", [](const Scene& s) {
         std::vector<std::string> t;
         for (const Joint& j : s.model.joints) t.push_back(toString(j.type));
         return t;
       })
-      .def_property_readonly("position_names", [](const Scene& s) { return coordinateNames(s.model, false); })
-      .def_property_readonly("velocity_names", [](const Scene& s) { return coordinateNames(s.model, true); })
-      .def_property_readonly("constraint_names", &constraintNames)
+      .def_property_readonly("position_names", [](const Scene& s) { return pythonTexts(coordinateNames(s.model, false)); })
+      .def_property_readonly("velocity_names", [](const Scene& s) { return pythonTexts(coordinateNames(s.model, true)); })
+      .def_property_readonly("constraint_names", [](const Scene& s) { return pythonTexts(constraintNames(s)); })
       .def_property_readonly("contact_names", [](const Scene& s) {
         std::vector<std::string> n;
         for (const auto& c : s.contacts) n.push_back(c->name());
-        return n;
+        return pythonTexts(n);
       })
       .def_property_readonly("joint_limit_names", [](const Scene& s) {
         std::vector<std::string> n;
         for (const auto& c : s.joint_limits) n.push_back(c->name());
-        return n;
+        return pythonTexts(n);
       })
       .def_property_readonly("actuator_names", [](const Scene& s) {
         std::vector<std::string> n;
         for (const Actuator& a : s.actuators) n.push_back(a.name);
-        return n;
+        return pythonTexts(n);
       })
       .def_property_readonly("mimic_names", [](const Scene& s) {
         std::vector<std::string> n;
         for (const auto& c : s.couplings) n.push_back(c->name());
-        return n;
+        return pythonTexts(n);
       })
       .def_property_readonly("support_names", [](const Scene& s) {
         std::vector<std::string> n;
         for (const Support& sp : s.supports) n.push_back(sp.name);
-        return n;
+        return pythonTexts(n);
       })
       .def_property_readonly("constraint_sizes", [](const Scene& s) {
         std::vector<int> r;
@@ -196,7 +196,7 @@ void bindScene(py::module_& m) {
         for (const auto& c : s.constraints) u.push_back(c->unilateral());
         return u;
       })
-      .def_property_readonly("row_labels", &rowLabels)
+      .def_property_readonly("row_labels", [](const Scene& s) { return pythonTexts(rowLabels(s)); })
       .def_property_readonly("row_kinds", [](const Scene& s) {
         std::vector<std::string> k;
         for (const auto& c : s.constraints)

@@ -89,7 +89,15 @@ void setJointForces(PySimulation& s, py::object tau) {
         return;
       }
       try {
-        VecX r = tau(t, q, v).cast<VecX>();
+        const py::object returned = tau(t, q, v);
+        VecX r;
+        try {
+          r = returned.cast<VecX>();
+        } catch (const py::cast_error&) {
+          throw py::type_error("joint forces: the callback returned " +
+                               py::str(py::type::of(returned).attr("__name__")).cast<std::string>() +
+                               ", not an array of nv = " + std::to_string(nv) + " numbers");
+        }
         if (r.size() != nv)
           throw std::invalid_argument("joint forces: the callback returned " + std::to_string(r.size()) +
                                       " values, the model has nv = " + std::to_string(nv));
@@ -100,7 +108,14 @@ void setJointForces(PySimulation& s, py::object tau) {
       }
     });
   } else {
-    const VecX c = tau.cast<VecX>();
+    VecX c;
+    try {
+      c = tau.cast<VecX>();
+    } catch (const py::cast_error&) {
+      throw py::type_error("joint forces: expected None, an array of nv = " + std::to_string(nv) +
+                           " numbers or a callable tau(t, q, v), not " +
+                           py::str(py::type::of(tau).attr("__name__")).cast<std::string>());
+    }
     checkVector(c, nv, "joint forces");
     s.simulator().setJointForces([c](double, const VecX&, const VecX&, VecX& out) { out = c; });
   }

@@ -110,3 +110,25 @@ def test_junk_nodes_are_refused_not_a_dead_interpreter():
     xml = '<robot name="r">\n<1 " >' + "<x>" * 70000 + '<2 " >' + "</x>" * 70000 + "</robot>"
     with pytest.raises(appell.SceneError, match=r"junk.urdf:2: malformed XML: '<1 \" >' is not an element"):
         appell.load_scene_from_string(xml, name="junk.urdf")
+
+
+def test_errors_say_what_was_wrong():
+    # Reproducer 15: "Unable to cast Python instance" for a wrong type, a
+    # SceneError with an empty message for a path that is not UTF-8.
+    sim = appell.Simulation(appell.load_scene(DISK))
+    with pytest.raises(TypeError, match=r"joint forces: expected None, an array of nv = 6 numbers or a callable"):
+        sim.set_joint_forces("strong")
+    # The callback is called at once (the reports of the current state include it).
+    with pytest.raises(TypeError, match=r"the callback returned str, not an array of nv = 6 numbers"):
+        sim.set_joint_forces(lambda t, q, v: "strong")
+    with pytest.raises(appell.SceneError) as missing:
+        appell.load_scene(b"/nonexistent/\xff\xfe.urdf")
+    assert "nonexistent" in str(missing.value) and "\\xff" in str(missing.value)
+
+
+def test_a_link_name_that_is_not_utf8_reads_back():
+    # Reproducer 15: body_names raised UnicodeDecodeError for such a name.
+    xml = ('<robot name="r"><link name="caf\x80"><inertial><mass value="1"/>'
+           '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>')
+    scene = appell.load_scene_from_string(xml.encode("latin-1"), name="latin1.urdf")
+    assert scene.body_names == ["caf\\x80"]

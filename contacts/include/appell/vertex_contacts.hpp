@@ -59,7 +59,9 @@ constexpr int kMaxHullContacts = 128;
 /// Throws std::invalid_argument naming the shape for any other shape, a mesh
 /// without triangles, or a mesh whose vertices span no volume or area. When
 /// a mesh's hull had to be reduced, `hull_vertices` (if given) receives the
-/// hull's own vertex count, else 0.
+/// mesh's vertex count, else 0. A mesh of more than 2·10⁴ vertices skips the
+/// hull altogether: its support points are found among all its vertices
+/// (the farthest point along a direction is a hull vertex), O(K n).
 std::vector<Vec3> contactVertices(const Shape& shape, int rim_points = 16, int* hull_vertices = nullptr);
 
 /// One point contact per candidate vertex of spec.shape, each with spec's

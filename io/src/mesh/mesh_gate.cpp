@@ -9,7 +9,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
+#include <vector>
 
 namespace appell::io {
 
@@ -95,7 +98,7 @@ std::string describeOther(const std::string& bytes, std::size_t i) {
     if (startsWith(bytes, i, magic)) return std::string("a file starting with \"") + magic + "\"";
   const bool binary = std::find(bytes.begin(), bytes.begin() + static_cast<long>(std::min<std::size_t>(bytes.size(), 4096)),
                                 '\0') != bytes.begin() + static_cast<long>(std::min<std::size_t>(bytes.size(), 4096));
-  return binary ? "a binary file of no format appell reads" : "a text file of no format appell reads";
+  return binary ? "a binary file of another format" : "a text file of another format";
 }
 
 MeshFormat sniff(const std::string& path, const std::string& bytes) {
@@ -141,23 +144,78 @@ std::string readBounded(const std::string& path) {
 
 }  // namespace
 
-// PLY: every "element NAME COUNT" of the header must fit the file (each
-// element takes at least one byte); assimp reserves COUNT before reading.
+// PLY: the header must follow the format's grammar line by line (Turk,
+// "The PLY polygon file format", 1994) — a damaged header of 187 bytes kept
+// assimp's PLY reader looping for ever — and every "element NAME COUNT" must
+// fit the file (each element takes at least one byte; assimp reserves COUNT
+// before reading).
 void checkPlyHeader(const std::string& path, const std::string& bytes) {
-  const std::size_t end = bytes.find("end_header");
-  std::istringstream header(bytes.substr(0, end == std::string::npos ? std::min<std::size_t>(bytes.size(), 65536) : end));
-  std::string line;
-  for (long number = 1; std::getline(header, line); ++number) {
-    std::istringstream words(line);
-    std::string key, name, count;
-    if (!(words >> key) || key != "element") continue;
-    words >> name >> count;
-    const bool digits = !count.empty() && count.size() <= 19 &&
-                        std::all_of(count.begin(), count.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
-    if (!digits || std::stoull(count) > bytes.size())
-      throw SceneError(path + ":" + std::to_string(number) + ": element " + name + " " + count +
-                       ": more elements than the file could hold: the file is damaged");
+  const std::size_t end = bytes.find("\nend_header");
+  if (end == std::string::npos || end > 65536)
+    throw SceneError(path + ": PLY header without an end_header line in its first 64 KiB: the file is damaged");
+  // The header is ASCII text: a NUL or a control byte inside a keyword let a
+  // damaged header pass as words and crash the reader.
+  for (std::size_t k = 0; k < end; ++k) {
+    const unsigned char c = static_cast<unsigned char>(bytes[k]);
+    if ((c < 0x20 && c != '\n' && c != '\r' && c != '\t') || c > 0x7E)
+      throw SceneError(path + ":" + std::to_string(lineAt(bytes, k)) +
+                       ": the PLY header holds a byte that is not ASCII text: the file is damaged");
   }
+  // "end_header" alone on its line: what follows it is the data (a binary
+  // body read from a misplaced start crashed assimp's reader).
+  const std::size_t data = end + 11;
+  const bool crlf = bytes.compare(data, 2, "\r\n") == 0;
+  if (!crlf && bytes.compare(data, 1, "\n") != 0)
+    throw SceneError(path + ":" + std::to_string(lineAt(bytes, data)) +
+                     ": PLY header: 'end_header' must end its line: the file is damaged");
+  const std::size_t body = data + (crlf ? 2 : 1);
+  static const std::map<std::string, int> kTypes = {
+      {"char", 1},  {"uchar", 1},  {"short", 2},  {"ushort", 2},  {"int", 4},     {"uint", 4},
+      {"float", 4}, {"double", 8}, {"int8", 1},   {"uint8", 1},   {"int16", 2},   {"uint16", 2},
+      {"int32", 4}, {"uint32", 4}, {"float32", 4}, {"float64", 8}};
+  bool binary = false;
+  std::uintmax_t least = 0, count = 0;  // bytes the declared elements need at least (binary)
+
+  std::istringstream header(bytes.substr(0, end));
+  std::string line;
+  bool element_seen = false;
+  for (long number = 1; std::getline(header, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream in(line);
+    std::vector<std::string> w;
+    for (std::string word; in >> word;) w.push_back(word);
+    auto bad = [&](const std::string& why) {
+      throw SceneError(path + ":" + std::to_string(number) + ": PLY header line '" + line.substr(0, 60) + "': " + why +
+                       ": the file is damaged");
+    };
+    if (number == 1) {
+      if (w.size() != 1 || w[0] != "ply") bad("the first line must be 'ply'");
+    } else if (w.empty() || w[0] == "comment" || w[0] == "obj_info") {
+      continue;
+    } else if (w[0] == "format") {
+      if (w.size() != 3 || (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
+        bad("not 'format ascii|binary_little_endian|binary_big_endian VERSION'");
+      binary = w[1] != "ascii";
+    } else if (w[0] == "element") {
+      const bool digits = w.size() == 3 && w[2].size() <= 19 &&
+                          std::all_of(w[2].begin(), w[2].end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+      if (!digits) bad("not 'element NAME COUNT'");
+      if (std::stoull(w[2]) > bytes.size()) bad("more elements than the file could hold");
+      count = std::stoull(w[2]);
+      element_seen = true;
+    } else if (w[0] == "property") {
+      const bool scalar = w.size() == 3 && kTypes.count(w[1]);
+      const bool list = w.size() == 5 && w[1] == "list" && kTypes.count(w[2]) && kTypes.count(w[3]);
+      if (!scalar && !list) bad("not 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
+      if (!element_seen) bad("a property before any element");
+      least += count * static_cast<std::uintmax_t>(kTypes.at(list ? w[2] : w[1]));  // a list: its count
+    } else {
+      bad("not a PLY header keyword");
+    }
+  }
+  if (binary && least > bytes.size() - body)
+    throw SceneError(path + ": the PLY header declares at least " + std::to_string(least) + " bytes of data, the file has " +
+                     std::to_string(bytes.size() - body) + ": the file is damaged (cut short?)");
 }
 
 MeshFile readMeshFile(const std::string& path) {

@@ -66,12 +66,12 @@ std::size_t elementTagEnd(const std::string& xml, std::size_t i) {
   return std::string::npos;
 }
 
-[[noreturn]] void junkNode(const XmlSource& src, const std::string& xml, std::size_t i) {
+[[noreturn]] void junkNode(const XmlSource& src, const std::string& xml, std::size_t i,
+                           const char* why = "is not an element, an end tag, a comment or a declaration") {
   const long line = 1 + std::count(xml.begin(), xml.begin() + static_cast<long>(i), '\n');
   const std::size_t end = xml.find('>', i);
   const std::string node = xml.substr(i, end == std::string::npos ? 16 : std::min<std::size_t>(end - i + 1, 64));
-  throw SceneError(src.file + ":" + std::to_string(line) + ": malformed XML: '" + clipped(node) +
-                   "' is not an element, an end tag, a comment or a declaration");
+  throw SceneError(src.file + ":" + std::to_string(line) + ": malformed XML: '" + clipped(node) + "' " + why);
 }
 
 }  // namespace
@@ -89,7 +89,7 @@ static int nestingDepth(const XmlSource& src, const std::string& xml, int limit)
       end = xml.find('>', i);
     } else if (startsWith(xml, i, "</")) {
       end = xml.find('>', i);
-      if (depth == 0) junkNode(src, xml, i);  // an end tag with no element open
+      if (depth == 0) junkNode(src, xml, i, "closes no open element");
       --depth;
     } else if (i + 1 < n && (std::isalpha(static_cast<unsigned char>(xml[i + 1])) || xml[i + 1] == '_' ||
                              static_cast<unsigned char>(xml[i + 1]) >= 127)) {
