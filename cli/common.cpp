@@ -2,6 +2,7 @@
 
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
+#include <appell/simulator.hpp>
 
 #include <iostream>
 #include <sstream>
@@ -29,6 +30,7 @@ std::string helpText(const char* text) {
   };
   replace("{integrators}", canonicalNames(integratorTable()));
   replace("{formulations}", canonicalNames(formulationTable()));
+  replace("{contact_schemes}", canonicalNames(contactSchemeTable()));
   return s;
 }
 

@@ -30,6 +30,7 @@ struct SimulationOptions {
   bool project_velocities = true;
   bool contact_events = true;      ///< unilateral contacts may open (ContactEventOptions)
   double settle_time = ContactEventOptions{}.settle_time;  ///< ContactEventOptions::settle_time
+  std::string contacts;            ///< a name of contactSchemeTable() (empty: the scene's)
 };
 
 /// The states a stepping loop passed: one row per sample.

@@ -180,7 +180,7 @@ void bindSimulation(py::module_& m) {
                       std::optional<std::string> formulation, std::optional<double> dt,
                       std::optional<double> rtol, std::optional<double> atol, double h_min, double h_max,
                       bool project_positions, bool project_velocities, bool contact_events,
-                      double settle_time) {
+                      double settle_time, std::optional<std::string> contacts) {
              SimulationOptions o;
              o.integrator = integrator.value_or("");
              o.formulation = formulation.value_or("");
@@ -193,12 +193,14 @@ void bindSimulation(py::module_& m) {
              o.project_velocities = project_velocities;
              o.contact_events = contact_events;
              o.settle_time = settle_time;
+             o.contacts = contacts.value_or("");
              return std::make_unique<PySimulation>(std::move(scene), o);
            }),
            "scene"_a, py::kw_only(), "integrator"_a = py::none(), "formulation"_a = py::none(),
            "dt"_a = py::none(), "rtol"_a = py::none(), "atol"_a = py::none(), "h_min"_a = 1e-14,
            "h_max"_a = 0.1, "project_positions"_a = true, "project_velocities"_a = true,
-           "contact_events"_a = true, "settle_time"_a = ContactEventOptions{}.settle_time)
+           "contact_events"_a = true, "settle_time"_a = ContactEventOptions{}.settle_time,
+           "contacts"_a = py::none())
       .def_property_readonly("scene", [](const PySimulation& s) { return std::const_pointer_cast<Scene>(s.scenePtr()); })
       .def_property_readonly("dt", &PySimulation::dt)
       .def_property_readonly("integrator", [](PySimulation& s) { return std::string(toString(s.simulator().integrator().type())); })

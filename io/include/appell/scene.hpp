@@ -84,6 +84,7 @@ struct SimulationSettings {
   double tol = 1e-8;               ///< adaptive methods: relative tolerance
   double duration = 1.0;
   std::string formulation = "tree";  ///< a canonical name of formulationTable()
+  std::string contacts = "auto";     ///< a canonical name of contactSchemeTable()
 };
 
 /// The vertex contacts one <contact> on a box, mesh or standing cylinder
