@@ -86,7 +86,9 @@ TEST(ContactFriction, PushedBallSlipsWhenTheDemandReachesMu) {
       });
       ASSERT_TRUE(sim.setState(0, s.q0, s.v0));
       const auto events = appell::test::advanceCollecting(sim, t_star + 0.2);
-      ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it);
+      std::string listed;
+      for (const ContactEvent& e : events) listed += " " + std::string(toString(e.kind)) + "@" + std::to_string(e.t);
+      ASSERT_EQ(events.size(), 1u) << toString(f) << " " << toString(it) << ":" << listed;
       EXPECT_EQ(events[0].kind, ContactEventKind::Slip);
       EXPECT_NEAR(events[0].t, t_star, 1e-10) << toString(f) << " " << toString(it);
       // Rolling until t*: v = (5/7) k t²/(2m); then a = (kt − μmg)/m.

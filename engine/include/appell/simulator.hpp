@@ -46,7 +46,10 @@ ContactScheme contactSchemeFromString(const std::string& name);
 /// The time-stepping scheme and the automatic switch (docs/contacts.md §10).
 struct TimeSteppingOptions {
   double step = 1e-3;        ///< h of a Moreau–Jean step (s); a shorter requested step is taken
-  double theta = 0.5;        ///< q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v)
+  /// q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v). θ = 1: a contact's gap target
+  /// (u⁺ₙ ≥ −g/h) lands it on g = 0 at the step's end; below 1 a landing
+  /// penetrates by O(h u⁻ₙ), pushed out over the next step.
+  double theta = 1.0;
   /// The contact problem is solved until the natural-map residual of the
   /// Coulomb law in De Saxcé's form is below residual_tol · max(1, |u_free|∞)
   /// (m/s) or max_sweeps Gauss–Seidel sweeps are done (counted, never fatal).

@@ -106,7 +106,6 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
 // searches past the pieces the closed ones hold.
 bool Simulator::decideContactModes(std::string& error) {
   for (auto& r : uni_->rows) cdata_->setActive(r.c, false);
-  for (auto& blk : cdata_->blocks) blk.latched_feature = -1;
   for (bool more = true; more;) {
     more = false;
     applyLatches();

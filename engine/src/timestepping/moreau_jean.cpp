@@ -105,8 +105,9 @@ void MoreauJean::selectCandidates(const ConstraintData& cdata, double h, double 
   for (int k = 0; k < static_cast<int>(all_.size()); ++k) {
     const Candidate& cand = all_[k];
     const int at = first_[k];
+    // The gap at q̃, predicted for the step's end.
     const double gap = cdata.gap[cdata.offset[cand.c] + cand.normal];
-    if (!(gap + h * ufree_[at] <= gap_tol_)) continue;
+    if (!(gap <= gap_tol_)) continue;
     active_.push_back(k);
     const int o = problem_.add(cand.nf, cand.ne, cand.mu);
     for (int i = 0; i < cand.rows(); ++i) {
@@ -115,9 +116,13 @@ void MoreauJean::selectCandidates(const ConstraintData& cdata, double h, double 
       problem_.target[o + i] = 0;
       problem_.P[o + i] = warm_[6 * k + i];
     }
-    // Newton's restitution on an approach faster than the rest speed.
+    // Newton's restitution on an approach faster than the rest speed; an
+    // open gap may close within the step, to land on g = 0 at its end
+    // (q⁺ = q + h v⁺ at θ = 1), and a gap at round-off below 0 reopens.
     const double approach = -uminus_[at];
-    if (approach > rest_speed) problem_.target[o] = cand.restitution * approach;
+    problem_.target[o] = ufree_[at] - gap / h;  // g⁺ ≈ g̃ + h (u⁺ − u_free) ≥ 0
+    if (approach > rest_speed)
+      problem_.target[o] = std::max(problem_.target[o], cand.restitution * approach);
   }
 }
 
@@ -127,7 +132,12 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
                       double rest_speed) {
   error_.clear();
   work_ = {};
-  // Every unilateral constraint closed and sticking: its rows at (t, q, v).
+  if (!freeVelocity(model, data, constraints, cdata, solver, tau_fn, t, q, v, h)) return false;
+  // The contacts at the predicted end q̃ = q ⊕ h v_free (θ = 1): a floating
+  // body's body-frame velocity is measured in its frame at the step's end
+  // (at q, the frame's turn h ω would enter the normal velocity as a
+  // spurious h ω × v — a ball rolling at 2 m/s lost a third of its load).
+  integrate(model, q, vfree_, h, qnext_);
   int list[6];
   for (const Candidate& k : all_) {
     cdata.setActive(k.c, true);
@@ -137,12 +147,11 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
     cdata.blocks[k.c].latched_feature = -1;
     cdata.blocks[k.c].excluded_count = 0;
   }
-  evaluateConstraintRows(model, data, constraints, cdata, t, q, v);
+  evaluateConstraintRows(model, data, constraints, cdata, t + h, qnext_, vfree_);
   for (int k = 0; k < static_cast<int>(all_.size()); ++k)
     delassus_.assemble(model, data, constraints, cdata, all_[k].c, list, rowList(all_[k], list),
                        first_[k]);
   const int rows = rows_;
-  if (!freeVelocity(model, data, constraints, cdata, solver, tau_fn, t, q, v, h)) return false;
   if (rows > 0) {
     uminus_.head(rows) = delassus_.b.head(rows);
     uminus_.head(rows).noalias() += delassus_.J.topRows(rows) * v;
@@ -158,8 +167,18 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
     }
   const int n = problem_.n;
   if (n > 0) {
-    if (!delassus_.respond(model, data, constraints, cdata, solver, q, v, tau_, vdot_, map_, n,
-                           res2_, problem_.W, error_))
+    // The Delassus operator at q̃, over the bilateral rows there.
+    for (const Candidate& k : all_) cdata.setActive(k.c, false);
+    evaluateConstraintRows(model, data, constraints, cdata, t + h, qnext_, vfree_);
+    solver.solve(model, data, constraints, cdata, qnext_, vfree_, tau_, res2_,
+                 SolveOutputs::Accelerations);
+    if (!res2_.ok) {
+      error_ = "the Delassus operator's solve failed: " + res2_.error;
+      return false;
+    }
+    vdot_ = res2_.vdot;
+    if (!delassus_.respond(model, data, constraints, cdata, solver, qnext_, vfree_, tau_, vdot_,
+                           map_, n, res2_, problem_.W, error_))
       return false;
     problem_.solve(options_.residual_tol, options_.max_sweeps);
   } else {
