@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -35,6 +36,14 @@ const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
                       dopri5 unless the scene's integrator is adaptive
   --integrator NAME   {integrators}
   --formulation F     {formulations}   (default: the scene's, else tree)
+  --contacts S        {contact_schemes}   how unilateral contacts are
+                      handled (default: the scene's, else auto): events
+                      locates every touchdown, lift-off, slip and stick and is
+                      exact between them; timestepping takes Moreau–Jean
+                      impulse steps of 1 ms (never stalls, O(h)); auto runs
+                      events and switches to time-stepping windows where a
+                      mode decision fails, events pile up or the steps
+                      collapse (docs/contacts.md §10)
   --out FILE.csv      write the trajectory (every step, or every --every N)
   --every N           write every N-th step to the CSV (default 1)
   --plot              plot the trajectory at the end (as `appell plot`, into
@@ -47,7 +56,7 @@ const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
                       constraint: the joint stops or bounces there)
   --snap-angles TOL   snap origin angles within TOL rad of a multiple of π/2
                       (CAD rounding: rpy="-1.57"), each change reported
-)" APPELL_INERTIA_HELP R"(  --quiet             no progress bar
+)" APPELL_INERTIA_HELP R"(  --quiet             no progress (a bar on a terminal, else a line every 10 s)
   --max-energy-error E  stop when the work balance (E + impact and friction
                       losses − work of joint forces and moving supports − E0)
                       is off by more than E relative, keeping the last state
@@ -81,26 +90,45 @@ are written), 2 usage, 3 the simulation failed (the
 summary says why and at what time; the trajectory up to there is written).
 )";
 
+// Progress on stderr: on a terminal a bar with the simulated time, the rate
+// (simulated seconds per wall second) and the time left at that rate; into a
+// file or pipe a line every 10 s of wall time — a long run is never silent.
 class Progress {
  public:
-  Progress(double total, bool enabled) : total_(total), enabled_(enabled && isatty(2)) {}
+  Progress(double total, bool enabled)
+      : total_(total), enabled_(enabled), tty_(isatty(2) != 0), start_(Clock::now()), last_line_(start_) {}
   void update(double t) {
     if (!enabled_) return;
+    const Clock::time_point now = Clock::now();
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    const double rate = wall > 0 ? t / wall : 0;
+    const double eta = rate > 0 ? (total_ - t) / rate : 0;
+    if (!tty_) {
+      if (std::chrono::duration<double>(now - last_line_).count() < 10) return;
+      last_line_ = now;
+      std::cerr << "appell: t = " << t << " s of " << total_ << " s, " << rate
+                << " x real time, about " << eta << " s left\n" << std::flush;
+      return;
+    }
     const int pct = static_cast<int>(100.0 * t / total_);
-    if (pct == last_) return;
+    if (pct == last_ && std::chrono::duration<double>(now - last_line_).count() < 1) return;
     last_ = pct;
-    const int w = 40, filled = w * pct / 100;
+    last_line_ = now;
+    const int w = 30, filled = w * std::clamp(pct, 0, 100) / 100;
     std::cerr << "\r[" << std::string(filled, '#') << std::string(w - filled, ' ') << "] "
-              << std::setw(3) << pct << "%  t = " << t << " s" << std::flush;
+              << std::setw(3) << pct << "%  t = " << std::setprecision(4) << t << " s  "
+              << rate << "x  ETA " << std::setprecision(3) << eta << " s   " << std::flush;
   }
   void done() {
-    if (enabled_ && last_ >= 0) std::cerr << "\r" << std::string(70, ' ') << "\r";
+    if (enabled_ && tty_ && last_ >= 0) std::cerr << "\r" << std::string(78, ' ') << "\r";
   }
 
  private:
+  using Clock = std::chrono::steady_clock;
   double total_;
-  bool enabled_;
+  bool enabled_, tty_;
   int last_ = -1;
+  Clock::time_point start_, last_line_;
 };
 
 // The per-contact lines of the summary.
@@ -217,8 +245,14 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
       << (adaptive ? o.tol : o.dt) << "), formulation " << toString(o.formulation) << "\n"
       << "simulated    " << r.time << " s in " << c.steps << " steps";
   if (c.rejected) out << " (" << c.rejected << " rejected)";
-  out << ", " << c.evaluations << " dynamics solves\n"
-      << "wall time    " << r.wall_seconds << " s, "
+  out << ", " << c.evaluations << " dynamics solves\n";
+  if (c.timestepping_steps > 0 || o.contacts != ContactScheme::Auto)
+    out << "contacts     " << toString(o.contacts) << " scheme: " << c.timestepping_steps
+        << " time-stepping steps in " << c.windows << " windows, contact problems to "
+        << c.max_contact_residual << " m/s"
+        << (c.unconverged ? " (" + std::to_string(c.unconverged) + " at max sweeps)" : std::string())
+        << "\n";
+  out << "wall time    " << r.wall_seconds << " s, "
       << 1e6 * r.wall_seconds / std::max<long>(1, c.steps) << " µs per step\n"
       << "energy       E0 = " << r.energy0 << " J, max |E "
       << (r.events.empty() ? "" : "+ impact losses ") << (r.friction_work > 0 ? "+ friction work " : "")
@@ -419,7 +453,8 @@ int run(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"duration", "dt", "tol", "integrator", "formulation", "out", "every", "package-path",
              "bound-inertia", "bound-mass",
-             "max-energy-error", "max-residual", "settle-time", "set", "sweep", "format", "snap-angles"},
+             "max-energy-error", "max-residual", "settle-time", "set", "sweep", "format", "snap-angles",
+             "contacts"},
             {"project-initial", "no-joint-limits", "balance-inertia", "help", "no-projection", "quiet", "plot"});
   if (args.has("help")) {
     std::cout << helpText(kRunHelp);
@@ -448,6 +483,7 @@ int run(int argc, char** argv) {
     s.integrator = toString(IntegratorType::DormandPrince54);
   s.integrator = args.text("integrator", s.integrator);
   s.formulation = args.text("formulation", s.formulation);
+  s.contacts = args.text("contacts", s.contacts);
   if (args.has("plot") && !args.has("out")) throw UsageError("--plot plots the trajectory: give --out FILE.csv");
   RunOptions options;
   try {

@@ -2,6 +2,7 @@
 
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
+#include <appell/simulator.hpp>
 
 #include <filesystem>
 #include <iostream>
@@ -50,6 +51,7 @@ std::string helpText(const char* text) {
   };
   replace("{integrators}", canonicalNames(integratorTable()));
   replace("{formulations}", canonicalNames(formulationTable()));
+  replace("{contact_schemes}", canonicalNames(contactSchemeTable()));
   return s;
 }
 

@@ -204,6 +204,7 @@ TEST(Run, ADiskFallingFlatNamesTheSingularGeometry) {
     o.integrator = it;
     o.dt = 0.01;
     o.duration = 3;
+    o.contacts = ContactScheme::Events;  // the events' diagnosis (docs/contacts.md §10)
     const RunSummary s = runScene(scene, o, {});
     ASSERT_FALSE(s.ok) << toString(it);
     const bool named = s.failure.find("contact 'rim' is at the edge of its singular geometry") != std::string::npos ||
@@ -253,6 +254,9 @@ TEST(Run, AHugeJointForceIsNamedAsTheCauseOfTheFailure) {
   };
   RunOptions o = runOptions(withEffort("1e9").settings);
   o.duration = 0.01;
+  // The event scheme's diagnosis (auto would take the failing step with
+  // time-stepping windows and stop later on the energy watch).
+  o.contacts = ContactScheme::Events;
   const RunSummary huge = runScene(withEffort("1e9"), o);
   ASSERT_FALSE(huge.ok);
   EXPECT_NE(huge.failure.find("the likely cause: the joint force on 'front_left_joint' is 1e+09"),

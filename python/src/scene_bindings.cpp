@@ -9,6 +9,7 @@
 #include <appell/dynamics.hpp>
 #include <appell/integrators.hpp>
 #include <appell/output.hpp>
+#include <appell/simulator.hpp>
 #include <appell/urdf.hpp>
 
 #include <pybind11/eigen.h>
@@ -330,6 +331,8 @@ void bindScene(py::module_& m) {
   m.def("formulations", [] { return nameTable(formulationTable()); },
         "Formulation names, aliases and descriptions.");
   m.def("contact_event_kinds", [] { return nameTable(contactEventKindTable()); });
+  m.def("contact_schemes", [] { return nameTable(contactSchemeTable()); },
+        "Contact scheme names (Simulation(contacts=…)), aliases and descriptions.");
 }
 
 }  // namespace appell::python

@@ -46,6 +46,7 @@ Simulation::Simulation(std::shared_ptr<const Scene> scene, const SimulationOptio
   so.project_velocities = options.project_velocities;
   so.contacts.enabled = options.contact_events;
   so.contacts.settle_time = options.settle_time;
+  so.scheme = contactSchemeFromString(options.contacts.empty() ? set.contacts : options.contacts);
   sim_ = std::make_unique<Simulator>(s.model, s.constraints,
                                      makeSolver(formulation, s.model, s.constraints), integrator,
                                      io, so);

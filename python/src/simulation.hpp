@@ -35,6 +35,7 @@ struct SimulationOptions {
   double settle_time = ContactEventOptions{}.settle_time;  ///< ContactEventOptions::settle_time
   /// DivergenceWatch's bound (the run library's default); ∞ switches it off.
   double max_energy_error = 5e-2;
+  std::string contacts;            ///< a name of contactSchemeTable() (empty: the scene's)
 };
 
 /// The states a stepping loop passed: one row per sample.

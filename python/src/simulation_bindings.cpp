@@ -194,7 +194,8 @@ void bindSimulation(py::module_& m) {
                       std::optional<std::string> formulation, std::optional<double> dt,
                       std::optional<double> rtol, std::optional<double> atol, double h_min, double h_max,
                       bool project_positions, bool project_velocities, bool contact_events,
-                      double settle_time, double max_energy_error) {
+                      double settle_time, double max_energy_error,
+                      std::optional<std::string> contacts) {
              SimulationOptions o;
              o.integrator = integrator.value_or("");
              o.formulation = formulation.value_or("");
@@ -208,13 +209,14 @@ void bindSimulation(py::module_& m) {
              o.contact_events = contact_events;
              o.settle_time = settle_time;
              o.max_energy_error = max_energy_error;
+             o.contacts = contacts.value_or("");
              return std::make_unique<PySimulation>(std::move(scene), o);
            }),
            "scene"_a, py::kw_only(), "integrator"_a = py::none(), "formulation"_a = py::none(),
            "dt"_a = py::none(), "rtol"_a = py::none(), "atol"_a = py::none(), "h_min"_a = 1e-14,
            "h_max"_a = 0.1, "project_positions"_a = true, "project_velocities"_a = true,
            "contact_events"_a = true, "settle_time"_a = ContactEventOptions{}.settle_time,
-           "max_energy_error"_a = 5e-2)
+           "max_energy_error"_a = 5e-2, "contacts"_a = py::none())
       .def_property_readonly("scene", [](const PySimulation& s) { return std::const_pointer_cast<Scene>(s.scenePtr()); })
       .def_property_readonly("dt", &PySimulation::dt)
       .def_property_readonly("integrator", [](PySimulation& s) { return std::string(toString(s.simulator().integrator().type())); })

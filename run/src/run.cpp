@@ -3,6 +3,7 @@
 
 #include "contact_stats.hpp"
 #include "rank_margin.hpp"
+#include "stall_watch.hpp"
 #include "step_stability.hpp"
 #include "vertex_watch.hpp"
 
@@ -107,6 +108,7 @@ RunOptions runOptions(const SimulationSettings& settings) {
   o.tol = settings.tol;
   o.integrator = integratorFromString(settings.integrator);
   o.formulation = formulationFromString(settings.formulation);
+  o.contacts = contactSchemeFromString(settings.contacts);
   check(o);
   return o;
 }
@@ -121,6 +123,7 @@ std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& o
   sopt.project_positions = options.project_positions;
   sopt.project_velocities = options.project_velocities;
   sopt.contacts.settle_time = options.settle_time;
+  sopt.scheme = options.contacts;
   auto sim = std::make_unique<Simulator>(
       scene.model, scene.constraints,
       makeSolver(options.formulation, scene.model, scene.constraints), options.integrator, iopt,
@@ -197,6 +200,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   const bool watch_residual = std::isfinite(options.max_residual);
   run_detail::VertexWatch vertices(scene);  // boxes and meshes on terrain meshes
   bool restored = false;  // went back to the last good state (its loss counters restart)
+  run_detail::StallWatch stall(options.watchdog_fraction, options.watchdog_interval, sim.time(),
+                               s.events.size());
   while (sim.time() < options.duration * (1 - 1e-12)) {
     const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
     if (!status.ok) {
@@ -252,6 +257,16 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     if (adaptive) h = status.h_next;
     record(sim);
     margins.sample(sim, !sim.events().empty(), s.near_dependency);
+    if (stall.stalled(sim.time(), s.events.size())) {
+      s.time = sim.time();
+      const std::string why = stall.report(s);
+      // The automatic scheme takes over with time-stepping; otherwise stop.
+      if (!sim.openTimeSteppingWindow(why)) {
+        s.ok = false;
+        s.failure = why;
+        break;
+      }
+    }
     s.max_energy_deviation = std::max(s.max_energy_deviation, deviation);
     s.max_velocity_residual = std::max(s.max_velocity_residual, sim.velocityResidual());
     s.max_gap_residual = std::max(s.max_gap_residual, sim.gapResidual());

@@ -57,9 +57,14 @@ enum class ContactEventKind {
   Slip,       ///< a sticking contact's friction demand reached μ: it slides
   Stick,      ///< a sliding contact's slip stopped and sticking holds: it sticks
   Feature,    ///< a closed contact moved onto another face, edge or vertex of a terrain
+  /// The automatic scheme opened a time-stepping window (docs/contacts.md §10);
+  /// `constraint` is the contact whose mode decision failed or whose events
+  /// piled up (the first unilateral one when the step collapsed).
+  TimeStepping,
+  Events,     ///< the window closed: the event scheme decided the modes again
 };
-/// "touchdown", "bounce", "lift_off", "slip", "stick", "feature": the names of
-/// the run summary and CSV.
+/// "touchdown", "bounce", "lift_off", "slip", "stick", "feature",
+/// "timestepping", "events": the names of the run summary and CSV.
 std::span<const NamedValue<ContactEventKind>> contactEventKindTable();
 const char* toString(ContactEventKind kind);
 

@@ -30,10 +30,50 @@
 
 namespace appell {
 
+/// Which scheme handles the unilateral contacts (docs/contacts.md §10).
+enum class ContactScheme {
+  Events,        ///< event-driven: exact mode switches, located events (§7–8)
+  TimeStepping,  ///< Moreau–Jean: velocity-level impulses per fixed step
+  Auto,          ///< events, with time-stepping windows where they fail or pile up
+};
+/// "events", "timestepping" (time_stepping, moreau_jean), "auto": the names
+/// of --contacts, the scene's <simulation contacts="…"> and the Python option.
+std::span<const NamedValue<ContactScheme>> contactSchemeTable();
+const char* toString(ContactScheme scheme);
+/// Parses any name of contactSchemeTable(); throws std::invalid_argument otherwise.
+ContactScheme contactSchemeFromString(const std::string& name);
+
+/// The time-stepping scheme and the automatic switch (docs/contacts.md §10).
+struct TimeSteppingOptions {
+  double step = 1e-3;        ///< h of a Moreau–Jean step (s); a shorter requested step is taken
+  /// q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v). θ = 1: a contact's gap target
+  /// (u⁺ₙ ≥ −g/h) lands it on g = 0 at the step's end; below 1 a landing
+  /// penetrates by O(h u⁻ₙ), pushed out over the next step.
+  double theta = 1.0;
+  /// The contact problem is solved until the natural-map residual of the
+  /// Coulomb law in De Saxcé's form is below residual_tol · max(1, |u_free|∞)
+  /// (m/s) or max_sweeps Gauss–Seidel sweeps are done (counted, never fatal).
+  double residual_tol = 1e-10;
+  int max_sweeps = 2000;
+  // auto: when a window starts …
+  int zeno_events = 64;      ///< … this many events within zeno_time (s) of simulated time
+  double zeno_time = 1e-2;
+  int collapse_steps = 200;  ///< … or that many steps advance less than collapse_step each on average
+  double collapse_step = 1e-7;
+  // … and when it ends: at least min_window (s, doubled each time the events
+  // fail again within a window's length of its end), the contact modes
+  // unchanged over stable_steps steps, and the event scheme's modes decided.
+  double min_window = 0.05;
+  int stable_steps = 50;
+};
+
 namespace detail {
 enum class Crossing;
 struct UnilateralRow;
 struct FrictionProblem;
+}
+namespace timestepping {
+class MoreauJean;
 }
 
 struct SimulatorOptions {
@@ -46,6 +86,8 @@ struct SimulatorOptions {
   /// for lift-off detection: with it off, closed contacts never open.
   bool evaluate_end_state = true;
   ContactEventOptions contacts;    ///< unilateral contacts: events, impacts
+  ContactScheme scheme = ContactScheme::Auto;
+  TimeSteppingOptions timestepping;
 };
 
 /// Throws std::invalid_argument naming the first option that is NaN, infinite,
@@ -81,6 +123,13 @@ struct SimulatorCounters {
   /// Steps redone because their sticking contacts became over-constrained
   /// (one then slides: friction_overconstrained.cpp).
   long overconstrained = 0;
+  /// Time-stepping (docs/contacts.md §10): steps taken by it, the windows the
+  /// automatic scheme opened, contact problems that hit max_sweeps, and the
+  /// largest residual of a solved one.
+  long timestepping_steps = 0;
+  long windows = 0;
+  long unconverged = 0;
+  double max_contact_residual = 0;
 };
 
 class Simulator {
@@ -159,6 +208,17 @@ class Simulator {
   /// Whether unilateral constraint `c` is closed now.
   bool isClosed(int constraint) const { return cdata_->isActive(constraint); }
   const SimulatorCounters& counters() const { return counters_; }
+  /// The scheme of the next step: Events or TimeStepping (docs/contacts.md §10).
+  ContactScheme stepScheme() const {
+    return stepping_ ? ContactScheme::TimeStepping : ContactScheme::Events;
+  }
+  /// Under ContactScheme::Auto: opens a time-stepping window from the
+  /// current state (a watchdog's switch), logged as a TimeStepping event at
+  /// the next step. false when the scheme is not auto, no contact is
+  /// unilateral, or a window is already open.
+  bool openTimeSteppingWindow(const std::string& why);
+  /// Why the last window opened (empty before the first).
+  const std::string& windowReason() const { return window_reason_; }
 
   const Model& model() const { return model_; }
   const ConstraintList& constraints() const { return constraints_; }
@@ -201,6 +261,13 @@ class Simulator {
   StepStatus locateAndHandleEvent(StepStatus st, double h, int k = -1,
                                   detail::Crossing type = detail::Crossing{});
   double eventFunction(int u, detail::Crossing type);
+  // Time-stepping windows (simulator/timestepping_window.cpp).
+  bool decideContactModes(std::string& error);
+  StepStatus timeSteppingStep(double h);
+  void openWindow(int constraint, std::string why);
+  bool closeWindow();
+  void watchEvents(const StepStatus& st);
+  int namedContact(const std::string& message) const;
   bool restepTo(double tau, StepStatus& st);
   /// work_ after an integrator step from the last step's start.
   void takeStepWork(const StepResult& r);
@@ -249,6 +316,19 @@ class Simulator {
   enum WorkIndex { kFrictionWork, kJointWork, kSupportWork, kWorkTerms };
   static_assert(kWorkTerms <= AccelerationField::kMaxRates);
   std::array<double, kWorkTerms> work_{}, work_prev_{};
+  // Time-stepping: the stage, whether the next step is one, the open
+  // window (start, minimum length, modes unchanged since, the last modes),
+  // and the automatic switch's watches (rings of event and step times).
+  std::unique_ptr<timestepping::MoreauJean> mj_;
+  bool stepping_ = false;
+  double window_start_ = 0, window_min_ = 0, window_end_ = 0;
+  bool window_closed_once_ = false;
+  int stable_ = 0;
+  int window_contact_ = -1;  // a window to log at the next step (its contact), or −1
+  std::vector<signed char> last_modes_;
+  std::vector<double> event_ring_, step_ring_;
+  long event_count_ = 0, step_count_ = 0;
+  std::string window_reason_;
 };
 
 }  // namespace appell

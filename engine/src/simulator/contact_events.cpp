@@ -21,6 +21,8 @@ std::span<const NamedValue<ContactEventKind>> contactEventKindTable() {
       {ContactEventKind::Slip, "slip", {}, "a sticking contact's friction demand reached μ: it slides"},
       {ContactEventKind::Stick, "stick", {}, "a sliding contact stopped slipping and sticking holds"},
       {ContactEventKind::Feature, "feature", {}, "a closed contact moved onto another face, edge or vertex of a terrain"},
+      {ContactEventKind::TimeStepping, "timestepping", {"window"}, "the automatic scheme switched to time-stepping (a mode decision failed, events piled up or the step collapsed)"},
+      {ContactEventKind::Events, "events", {}, "the time-stepping window ended: the event scheme decided the modes again"},
   };
   return table;
 }

@@ -4,6 +4,7 @@
 #include <appell/tree_solver.hpp>
 
 #include "simulator/simulator_internal.hpp"
+#include "timestepping/moreau_jean.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -43,6 +44,14 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   result_.lambda = VecX::Zero(cdata_->m);
   result_.reaction = VecX::Zero(model_.nv);
   setUpUnilateral();  // after q_, v_: its workspace copies their sizes
+  timestepping::checkOptions(options_.timestepping);
+  if (uni_)
+    mj_ = std::make_unique<timestepping::MoreauJean>(model_, constraints_, options_.timestepping,
+                                                     options_.contacts.gap_tol);
+  last_modes_.assign(constraints_.size(), 0);
+  event_ring_.assign(options_.timestepping.zeno_events, 0.0);
+  step_ring_.assign(options_.timestepping.collapse_steps, 0.0);
+  window_min_ = options_.timestepping.min_window;
   // Size every per-step buffer of the field and the solver once, here.
   std::string ignored;
   evaluateEndState(ignored);
@@ -76,34 +85,47 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
   dissipated_ = 0;
   work_ = work_prev_ = {};
   if (uni_ && options_.contacts.enabled) {
-    // A new state: unilateral constraints with clearance start open, the
-    // touching ones get their modes decided (impact, then forces), each on
-    // its nearest piece.
-    // The points of a pair close one per pass: each next one searches past
-    // the pieces the closed ones hold.
-    for (auto& r : uni_->rows) cdata_->setActive(r.c, false);
-    for (bool more = true; more;) {
-      more = false;
-      applyLatches();
-      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-      for (auto& r : uni_->rows) {
-        if (cdata_->isActive(r.c)) continue;
-        r.lifting = r.touching_down = false;
-        r.feature = r.feature_start = r.feature_free = r.joint ? -1 : cdata_->blocks[r.c].feature;
-        if (r.dormant || !(cdata_->gap[r.global] <= options_.contacts.gap_tol)) continue;
-        cdata_->setActive(r.c, true);
-        more = more || !r.siblings.empty();
-      }
+    if (!decideContactModes(state_error_)) state_error_ = "initial contact modes: " + state_error_;
+    // Modes the events cannot decide: time-stepping decides them (auto), or
+    // is the scheme anyway.
+    event_count_ = step_count_ = 0;
+    stepping_ = mj_ && options_.scheme == ContactScheme::TimeStepping;
+    window_closed_once_ = false;
+    window_min_ = options_.timestepping.min_window;
+    if (mj_ && !state_error_.empty() && options_.scheme != ContactScheme::Events) {
+      if (options_.scheme == ContactScheme::Auto) openWindow(namedContact(state_error_), state_error_);
+      state_error_.clear();
     }
-    if (!decideModes(state_error_) || !frictionPhase(state_error_))
-      state_error_ = "initial contact modes: " + state_error_;
-    for (auto& r : uni_->rows) r.dir_start = r.dir;
-    applyLatches();
-    integrator_->reset();
   }
   std::string error;
   evaluateEndState(error);
   return state_error_.empty();
+}
+
+// Every unilateral constraint's mode at (t_, q_, v_) afresh: those with
+// clearance open, the touching ones decided (impact, then forces), each on
+// its nearest piece. The points of a pair close one per pass: each next one
+// searches past the pieces the closed ones hold.
+bool Simulator::decideContactModes(std::string& error) {
+  for (auto& r : uni_->rows) cdata_->setActive(r.c, false);
+  for (bool more = true; more;) {
+    more = false;
+    applyLatches();
+    evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    for (auto& r : uni_->rows) {
+      if (cdata_->isActive(r.c)) continue;
+      r.lifting = r.touching_down = false;
+      r.feature = r.feature_start = r.feature_free = r.joint ? -1 : cdata_->blocks[r.c].feature;
+      if (r.dormant || !(cdata_->gap[r.global] <= options_.contacts.gap_tol)) continue;
+      cdata_->setActive(r.c, true);
+      more = more || !r.siblings.empty();
+    }
+  }
+  const bool ok = decideModes(error) && frictionPhase(error);
+  for (auto& r : uni_->rows) r.dir_start = r.dir;
+  applyLatches();
+  integrator_->reset();
+  return ok;
 }
 
 void Simulator::setJointForces(JointForces tau) {
@@ -195,6 +217,7 @@ StepStatus Simulator::step(double h) {
   v_prev_ = v_;
   work_prev_ = work_;
   events_.clear();
+  if (stepping_) return timeSteppingStep(h);
   StepStatus st = attemptStep(h);
   // Sticking contacts that became over-constrained inside the step: one
   // slides from the step's start, and the step is redone (at most once per
@@ -211,6 +234,18 @@ StepStatus Simulator::step(double h) {
     logEvent(ContactEventKind::Slip, k, 0, 0, 0);
     ++counters_.overconstrained;
     st = attemptStep(h);
+  }
+  if (mj_ && options_.scheme == ContactScheme::Auto && options_.contacts.enabled) {
+    if (!st.ok) {
+      // The events gave up here (no consistent mode, a step below h_min, a
+      // solve that failed): fail() restored the step's start, from which a
+      // time-stepping window takes the step.
+      --counters_.failed;
+      events_.clear();
+      openWindow(namedContact(st.message), st.message);
+      return timeSteppingStep(h);
+    }
+    watchEvents(st);
   }
   return st;
 }

@@ -87,6 +87,7 @@ struct SimulationSettings {
   /// Snap origin angles within this of a multiple of π/2 (rad; 0: no snap):
   /// LoadOptions::snap_angles, which overrides it when set.
   double snap_angles = 0;
+  std::string contacts = "auto";     ///< a canonical name of contactSchemeTable()
 };
 
 /// The vertex contacts one <contact> on a box, mesh or standing cylinder

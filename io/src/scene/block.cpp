@@ -4,6 +4,7 @@
 
 #include <appell/constrained_dynamics.hpp>
 #include <appell/integrators.hpp>
+#include <appell/simulator.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -348,12 +349,13 @@ ActuatorDecl parseActuator(const XmlSource& src, const TiXmlElement* e) {
 
 SimulationSettings parseSimulation(const XmlSource& src, const TiXmlElement* e) {
   allowOnly(src, e, {"integrator", "dt", "tol", "duration", "formulation", "snap_angles",
-                     "balance_inertia", "bound_inertia", "bound_mass"});
+                     "balance_inertia", "bound_inertia", "bound_mass", "contacts"});
   SimulationSettings s;
-  // Both names are stored canonical ("multipliers" reads as "kkt").
+  // The names are stored canonical ("multipliers" reads as "kkt").
   try {
     s.integrator = toString(integratorFromString(text(e, "integrator", s.integrator)));
     s.formulation = toString(formulationFromString(text(e, "formulation", s.formulation)));
+    s.contacts = toString(contactSchemeFromString(text(e, "contacts", s.contacts)));
   } catch (const std::invalid_argument& err) {
     fail(src, e, err.what());
   }

@@ -79,6 +79,16 @@ struct RunOptions {
   /// design makes dependent and CAD rounding made independent, locking a
   /// freedom (RunSummary::near_dependency). 0 switches the watch off.
   double near_dependency_level = 1e-3;
+  /// Which scheme handles the contacts (docs/contacts.md §10).
+  ContactScheme contacts = ContactScheme::Auto;
+  /// Stall watchdog: over every `watchdog_interval` seconds of wall time the
+  /// simulated time must advance at least `watchdog_fraction` of it. When it
+  /// does not, the automatic scheme opens a time-stepping window; otherwise
+  /// (events only, or already time-stepping) the run stops as failed, naming
+  /// the contacts, the events per simulated second and the last mode changes.
+  /// 0 switches it off.
+  double watchdog_fraction = 1e-3;
+  double watchdog_interval = 5.0;
 };
 
 /// The scene's own settings as run options. Throws std::invalid_argument for

@@ -1,0 +1,247 @@
+// The automatic contact scheme (docs/contacts.md §10): event-driven while the
+// events decide the modes and stay sparse, a Moreau–Jean window
+// (timestepping/moreau_jean.hpp) where they do not —
+//
+//   opens   when an event step fails (no consistent contact mode, a step
+//           below h_min, a solve that fails at a mode's state), when
+//           zeno_events events fall within zeno_time of simulated time
+//           (Zeno, slip ↔ stick chattering), when collapse_steps steps
+//           advance less than collapse_step each on average, or when the
+//           run's watchdog asks (openTimeSteppingWindow);
+//   closes  after at least its minimum length, once the contact modes have
+//           not changed over stable_steps steps and the event scheme decides
+//           the modes at the window's end (decideContactModes). A window
+//           that opens again within its length of the last one's end doubles
+//           that length (a scene that keeps failing stays time-stepped).
+//
+// Both switches are contact events (TimeStepping, Events), in the summary,
+// the CSV and the viewer's timeline.
+#include <appell/configuration.hpp>
+#include <appell/dynamics.hpp>
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_internal.hpp"
+#include "timestepping/moreau_jean.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace appell {
+
+std::span<const NamedValue<ContactScheme>> contactSchemeTable() {
+  static const NamedValue<ContactScheme> table[] = {
+      {ContactScheme::Events, "events", {"event_driven"},
+       "event-driven: located touchdowns, lift-offs, slips and sticks; exact between them"},
+      {ContactScheme::TimeStepping, "timestepping", {"time_stepping", "moreau_jean"},
+       "Moreau–Jean: velocity-level contact impulses per fixed step; never stalls, O(h)"},
+      {ContactScheme::Auto, "auto", {},
+       "events, with time-stepping windows where mode decisions fail or events pile up"},
+  };
+  return table;
+}
+
+const char* toString(ContactScheme scheme) {
+  for (const auto& e : contactSchemeTable())
+    if (e.value == scheme) return e.name;
+  return "?";
+}
+
+ContactScheme contactSchemeFromString(const std::string& name) {
+  return parseName(contactSchemeTable(), name, "contact scheme");
+}
+
+void timestepping::checkOptions(const TimeSteppingOptions& o) {
+  auto positive = [](const char* what, double x) {
+    if (!(x > 0) || !std::isfinite(x))
+      throw std::invalid_argument(std::string("Simulator: timestepping.") + what +
+                                  " must be positive and finite, got " + std::to_string(x));
+  };
+  positive("step", o.step);
+  positive("residual_tol", o.residual_tol);
+  positive("zeno_time", o.zeno_time);
+  positive("collapse_step", o.collapse_step);
+  positive("min_window", o.min_window);
+  if (!(o.theta > 0 && o.theta <= 1))
+    throw std::invalid_argument("Simulator: timestepping.theta must be in (0, 1], got " +
+                                std::to_string(o.theta));
+  if (o.max_sweeps < 1 || o.zeno_events < 2 || o.collapse_steps < 2 || o.stable_steps < 1)
+    throw std::invalid_argument(
+        "Simulator: timestepping.max_sweeps ≥ 1, zeno_events ≥ 2, collapse_steps ≥ 2 and "
+        "stable_steps ≥ 1 are required");
+}
+
+bool Simulator::openTimeSteppingWindow(const std::string& why) {
+  if (!mj_ || options_.scheme != ContactScheme::Auto || stepping_ || !options_.contacts.enabled)
+    return false;
+  openWindow(namedContact(why), why);
+  return true;
+}
+
+/// The unilateral constraint a message names ('name'), or the first one.
+int Simulator::namedContact(const std::string& message) const {
+  int first = -1;
+  for (const auto& r : uni_->rows) {
+    if (first < 0) first = r.c;
+    if (message.find("'" + constraints_[r.c]->name() + "'") != std::string::npos) return r.c;
+  }
+  return first;
+}
+
+void Simulator::openWindow(int constraint, std::string why) {
+  // Soon after the last window closed: the events failed again, so this
+  // one lasts twice as long.
+  const double min_window = options_.timestepping.min_window;
+  window_min_ = window_closed_once_ && t_ - window_end_ < window_min_
+                    ? std::min(2 * window_min_, 1e3 * min_window)
+                    : min_window;
+  stepping_ = true;
+  window_start_ = t_;
+  stable_ = 0;
+  window_reason_ = std::move(why);
+  window_contact_ = constraint;
+  ++counters_.windows;
+  integrator_->reset();
+}
+
+// The event scheme again, if it decides the modes at the window's end.
+bool Simulator::closeWindow() {
+  q_moved_ = q_;  // (the drift projection's scratch: no allocation)
+  v_moved_ = v_;
+  const double dissipated = dissipated_;
+  const std::size_t logged = events_.size();
+  std::string error;
+  if (!decideContactModes(error)) {
+    q_ = q_moved_;
+    v_ = v_moved_;
+    dissipated_ = dissipated;
+    events_.resize(logged);
+    return false;
+  }
+  ContactEvent e;
+  e.t = t_;
+  e.constraint = uni_->rows.front().c;
+  e.kind = ContactEventKind::Events;
+  events_.push_back(e);
+  stepping_ = false;
+  window_end_ = t_;
+  window_closed_once_ = true;
+  event_count_ = step_count_ = 0;
+  h_suggest_ = 0;
+  evaluateEndState(error);
+  return true;
+}
+
+// Zeno and collapse watches of the automatic scheme, after an event step.
+constexpr bool kCollapseWatch = false;
+void Simulator::watchEvents(const StepStatus& st) {
+  const TimeSteppingOptions& o = options_.timestepping;
+  // Mode changes only: a contact crossing a terrain's pieces keeps its mode.
+  int logged = 0;
+  for (const ContactEvent& e : events_)
+    if (e.kind != ContactEventKind::Feature) {
+      event_ring_[event_count_++ % o.zeno_events] = e.t;
+      ++logged;
+    }
+  step_ring_[step_count_++ % o.collapse_steps] = t_;
+  if (event_count_ >= o.zeno_events && logged > 0) {
+    const double oldest = event_ring_[event_count_ % o.zeno_events];
+    if (t_ - oldest <= o.zeno_time) {
+      std::ostringstream why;
+      why << o.zeno_events << " contact events within " << t_ - oldest
+          << " s of simulated time (Zeno or slip-stick chattering; last: '"
+          << constraints_[events_.back().constraint]->name() << "' "
+          << toString(events_.back().kind) << ")";
+      openWindow(events_.back().constraint, why.str());
+      return;
+    }
+  }
+  // The collapse watch is not armed: at tight tolerances the events take
+  // legitimate runs of tiny steps at a slip onset (ContactFriction.
+  // PushedBallSlipsWhenTheDemandReachesMu opened a window with it); the
+  // run loop's wall-clock watchdog catches a real stall.
+  if (kCollapseWatch && step_count_ >= o.collapse_steps) {
+    const double oldest = step_ring_[step_count_ % o.collapse_steps];
+    if (t_ - oldest < o.collapse_steps * o.collapse_step) {
+      std::ostringstream why;
+      why << "the step size collapsed: " << o.collapse_steps << " steps advanced " << t_ - oldest
+          << " s (the last " << st.h_taken << " s)";
+      openWindow(namedContact(""), why.str());
+    }
+  }
+}
+
+StepStatus Simulator::timeSteppingStep(double h) {
+  StepStatus st;
+  const double hs = std::min(h, options_.timestepping.step);
+  if (window_contact_ >= 0) {  // a window opened since the last step: log it
+    ContactEvent e;
+    e.t = t_;
+    e.constraint = window_contact_;
+    e.kind = ContactEventKind::TimeStepping;
+    events_.push_back(e);
+    window_contact_ = -1;
+  }
+  if (!mj_->step(model_, *data_, constraints_, *cdata_, *solver_, tau_fn_, t_, q_, v_, hs,
+                 options_.contacts.rest_speed)) {
+    // At a window's first step the events' own reason comes first.
+    const bool opening = options_.scheme == ContactScheme::Auto && t_ == window_start_;
+    return fail(st, (opening ? window_reason_ + "; time-stepping could not take over: " : std::string()) +
+                        "time-stepping at t = " + std::to_string(t_) + ": " + mj_->error());
+  }
+  t_ += hs;
+  st.h_taken = hs;
+  st.h_next = options_.timestepping.step;
+  st.evaluations = 1;
+  ++counters_.timestepping_steps;
+  if (!mj_->converged()) ++counters_.unconverged;
+  counters_.max_contact_residual = std::max(counters_.max_contact_residual, mj_->residual());
+  const timestepping::StepWork& w = mj_->work();
+  dissipated_ += w.impact;
+  work_[kFrictionWork] += w.friction;
+  work_[kJointWork] += w.joint;
+  work_[kSupportWork] += w.support;
+  // The drift projection holds the bilateral rows only: the contacts are
+  // held by the step's own targets (a closing gap lands on g = 0), and a
+  // projection of a floating body's position would turn its body-frame
+  // velocity — momentum the contact impulses did not change.
+  for (const auto& r : uni_->rows) cdata_->setActive(r.c, false);
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  if (options_.project_positions) {
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_, true);
+    st.projection_iterations = projection_.iterations;
+    counters_.projection_iterations += projection_.iterations;
+    if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
+  }
+  if (options_.project_velocities && cdata_->m_active > 0 &&
+      !solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_))
+    return fail(st, "velocity projection failed: " + solver_->lastError());
+  // The modes for reports (isClosed, sliding): what pushed and did not rebound.
+  bool changed = false;
+  for (const auto& r : uni_->rows) {
+    const timestepping::Mode m = mj_->modes()[r.c];
+    const bool closed = m != timestepping::Mode::Open && !mj_->rebounds(r.c);
+    cdata_->setActive(r.c, closed);
+    cdata_->setSliding(r.c, closed && m == timestepping::Mode::Slide);
+    changed = changed || last_modes_[r.c] != static_cast<signed char>(m);
+    last_modes_[r.c] = static_cast<signed char>(m);
+  }
+  // Reports: the step's forces (impulses over h), residuals, energy.
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  velocity_residual_ = appell::velocityResidual(*data_, constraints_, *cdata_, v_);
+  gap_residual_ = appell::gapResidual(*cdata_);
+  result_.lambda = mj_->lambda();
+  result_.vdot = (v_ - v_prev_) / hs;
+  result_.ok = true;
+  kinetic_ = appell::kineticEnergy(model_, *data_, q_, v_);
+  potential_ = appell::potentialEnergy(model_, *data_, q_);
+  ++counters_.steps;
+  stable_ = changed ? 0 : stable_ + 1;
+  if (options_.scheme == ContactScheme::Auto && t_ - window_start_ >= window_min_ &&
+      stable_ >= options_.timestepping.stable_steps && !closeWindow())
+    stable_ = 0;  // (the events still cannot decide: another stable stretch)
+  st.events = static_cast<int>(events_.size());
+  counters_.events += st.events;
+  return st;
+}
+
+}  // namespace appell

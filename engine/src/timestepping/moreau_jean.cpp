@@ -1,0 +1,233 @@
+// One Moreau–Jean step (moreau_jean.hpp states the scheme).
+#include "timestepping/moreau_jean.hpp"
+
+#include <appell/configuration.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace appell::timestepping {
+
+namespace {
+
+// The rows a candidate uses: normal, friction, equality (its row list).
+int rowList(const Candidate& k, int* out) {
+  int n = 0;
+  out[n++] = k.normal;
+  for (int i = 0; i < k.nf; ++i) out[n++] = k.f[i];
+  for (int i = 0; i < k.ne; ++i) out[n++] = k.e[i];
+  return n;
+}
+
+}  // namespace
+
+MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
+                       const TimeSteppingOptions& options, double gap_tol)
+    : options_(options), gap_tol_(gap_tol) {
+  int rows = 0;
+  for (int c = 0; c < static_cast<int>(constraints.size()); ++c) {
+    const Constraint& con = *constraints[c];
+    if (!con.unilateral()) continue;
+    Candidate k;
+    k.c = c;
+    k.normal = con.unilateralRow();
+    k.mu = con.friction();
+    k.restitution = con.restitution();
+    const bool coulomb = std::isfinite(k.mu);
+    for (int r = 0; r < con.rows(); ++r) {
+      if (r == k.normal) continue;
+      // Finite μ: tangent and lateral rows in the cone, spin rows free
+      // (torsional friction is the event scheme's). μ = ∞: every other row
+      // holds while the contact pushes (ideal rolling).
+      if (coulomb && isTangential(con.rowKind(r)) && k.nf < 3) k.f[k.nf++] = r;
+      else if (!coulomb && k.ne < 5) k.e[k.ne++] = r;
+    }
+    first_.push_back(rows);
+    rows += k.rows();
+    all_.push_back(k);
+  }
+  active_.reserve(all_.size());
+  modes_.assign(constraints.size(), Mode::Open);
+  rebound_.assign(constraints.size(), 0);
+  warm_.assign(6 * all_.size(), 0.0);
+  problem_.reserve(rows, static_cast<int>(all_.size()));
+  delassus_.reserve(model.nv, rows);
+  map_.reserve(rows);
+  rows_ = rows;
+  qnext_ = VecX::Zero(model.nq);
+  uminus_ = ufree_ = VecX::Zero(std::max(rows, 1));
+  tau_ = vfree_ = vdot_ = v0_ = VecX::Zero(model.nv);
+  ConstraintData cd(model, constraints, DenseRows::None);
+  lambda_ = impulse_ = VecX::Zero(cd.m);
+  res_.vdot = res2_.vdot = VecX::Zero(model.nv);
+  res_.lambda = res2_.lambda = VecX::Zero(cd.m);
+  res_.reaction = res2_.reaction = VecX::Zero(model.nv);
+}
+
+// v_free: the step's velocity without contact impulses, on the bilateral rows.
+bool MoreauJean::freeVelocity(const Model& model, Data& data, const ConstraintList& constraints,
+                              ConstraintData& cdata, ConstrainedSolver& solver,
+                              const Simulator::JointForces& tau_fn, double t, const VecX& q,
+                              const VecX& v, double h) {
+  for (const Candidate& k : all_) cdata.setActive(k.c, false);
+  evaluateConstraintRows(model, data, constraints, cdata, t, q, v);
+  tau_.setZero();
+  if (tau_fn) {
+    tau_fn(t, q, v, tau_);
+    if (tau_.size() != model.nv || !tau_.allFinite()) {
+      error_ = "the joint-force callback returned a non-finite or wrongly sized tau";
+      return false;
+    }
+  }
+  solver.solve(model, data, constraints, cdata, q, v, tau_, res_, SolveOutputs::All);
+  if (!res_.ok || !res_.vdot.allFinite()) {
+    error_ = "the free motion's solve failed: " + (res_.ok ? std::string("non-finite v̇") : res_.error);
+    return false;
+  }
+  vdot_ = res_.vdot;
+  vfree_ = v;
+  vfree_.noalias() += h * vdot_;
+  work_.support -= h * res_.lambda.dot(cdata.b);
+  lambda_ = res_.lambda;
+  if (cdata.m_active > 0 &&
+      !solver.projectVelocity(model, data, constraints, cdata, q, vfree_, impulse_)) {
+    error_ = "the free velocity's projection onto the bilateral rows failed: " + solver.lastError();
+    return false;
+  }
+  return true;
+}
+
+// Candidates: contacts whose gap closes within the step at the free velocity.
+void MoreauJean::selectCandidates(const ConstraintData& cdata, double h, double rest_speed) {
+  active_.clear();
+  problem_.clear();
+  map_.clear();
+  for (int k = 0; k < static_cast<int>(all_.size()); ++k) {
+    const Candidate& cand = all_[k];
+    const int at = first_[k];
+    // The gap at q̃, predicted for the step's end.
+    const double gap = cdata.gap[cdata.offset[cand.c] + cand.normal];
+    if (!(gap <= gap_tol_)) continue;
+    active_.push_back(k);
+    const int o = problem_.add(cand.nf, cand.ne, cand.mu);
+    for (int i = 0; i < cand.rows(); ++i) {
+      map_.push_back(at + i);
+      problem_.u_free[o + i] = ufree_[at + i];
+      problem_.target[o + i] = 0;
+      problem_.P[o + i] = warm_[6 * k + i];
+    }
+    // Newton's restitution on an approach faster than the rest speed; an
+    // open gap may close within the step, to land on g = 0 at its end
+    // (q⁺ = q + h v⁺ at θ = 1), and a gap at round-off below 0 reopens.
+    const double approach = -uminus_[at];
+    problem_.target[o] = ufree_[at] - gap / h;  // g⁺ ≈ g̃ + h (u⁺ − u_free) ≥ 0
+    if (approach > rest_speed)
+      problem_.target[o] = std::max(problem_.target[o], cand.restitution * approach);
+  }
+}
+
+bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& constraints,
+                      ConstraintData& cdata, ConstrainedSolver& solver,
+                      const Simulator::JointForces& tau_fn, double t, VecX& q, VecX& v, double h,
+                      double rest_speed) {
+  error_.clear();
+  work_ = {};
+  if (!freeVelocity(model, data, constraints, cdata, solver, tau_fn, t, q, v, h)) return false;
+  // The contacts at the predicted end q̃ = q ⊕ h v_free (θ = 1): a floating
+  // body's body-frame velocity is measured in its frame at the step's end
+  // (at q, the frame's turn h ω would enter the normal velocity as a
+  // spurious h ω × v — a ball rolling at 2 m/s lost a third of its load).
+  integrate(model, q, vfree_, h, qnext_);
+  int list[6];
+  for (const Candidate& k : all_) {
+    cdata.setActive(k.c, true);
+    cdata.setSliding(k.c, false);
+    // Each contact on its nearest piece of a terrain (no latches: the
+    // event scheme's way of keeping a piece between events).
+    cdata.blocks[k.c].latched_feature = -1;
+    cdata.blocks[k.c].excluded_count = 0;
+  }
+  evaluateConstraintRows(model, data, constraints, cdata, t + h, qnext_, vfree_);
+  for (int k = 0; k < static_cast<int>(all_.size()); ++k)
+    delassus_.assemble(model, data, constraints, cdata, all_[k].c, list, rowList(all_[k], list),
+                       first_[k]);
+  const int rows = rows_;
+  if (rows > 0) {
+    uminus_.head(rows) = delassus_.b.head(rows);
+    uminus_.head(rows).noalias() += delassus_.J.topRows(rows) * v;
+    ufree_.head(rows) = delassus_.b.head(rows);
+    ufree_.head(rows).noalias() += delassus_.J.topRows(rows) * vfree_;
+  }
+  selectCandidates(cdata, h, rest_speed);
+  for (int k : active_)
+    if (cdata.blocks[all_[k].c].singular) {
+      error_ = constraints[all_[k].c]->name() + ": " + cdata.blocks[all_[k].c].singular_reason +
+               " (a singular contact geometry: its rows are unusable)";
+      return false;
+    }
+  const int n = problem_.n;
+  if (n > 0) {
+    // The Delassus operator at q̃, over the bilateral rows there.
+    for (const Candidate& k : all_) cdata.setActive(k.c, false);
+    evaluateConstraintRows(model, data, constraints, cdata, t + h, qnext_, vfree_);
+    solver.solve(model, data, constraints, cdata, qnext_, vfree_, tau_, res2_,
+                 SolveOutputs::Accelerations);
+    if (!res2_.ok) {
+      error_ = "the Delassus operator's solve failed: " + res2_.error;
+      return false;
+    }
+    vdot_ = res2_.vdot;
+    if (!delassus_.respond(model, data, constraints, cdata, solver, qnext_, vfree_, tau_, vdot_,
+                           map_, n, res2_, problem_.W, error_))
+      return false;
+    problem_.solve(options_.residual_tol, options_.max_sweeps);
+  } else {
+    problem_.sweeps = 0;
+    problem_.residual = 0;
+    problem_.converged = true;
+  }
+  // v⁺ = v_free + R P.
+  v0_ = v;  // (v at the step's start, for the work and the positions)
+  v = vfree_;
+  if (n > 0) v.noalias() += delassus_.R.leftCols(n) * problem_.P.head(n);
+  finish(cdata, v0_, v, h);
+  // q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v).
+  vfree_ = options_.theta * v + (1 - options_.theta) * v0_;
+  integrate(model, q, vfree_, h, qnext_);
+  q.swap(qnext_);
+  return true;
+}
+
+// Work terms, modes, the reported forces, the next step's warm start.
+void MoreauJean::finish(const ConstraintData& cdata, const VecX& v0, const VecX& v1, double h) {
+  work_.joint = 0.5 * h * tau_.dot(v0 + v1);
+  std::fill(modes_.begin(), modes_.end(), Mode::Open);
+  std::fill(rebound_.begin(), rebound_.end(), 0);
+  std::fill(warm_.begin(), warm_.end(), 0.0);
+  const ContactProblem& p = problem_;
+  for (int j = 0; j < static_cast<int>(active_.size()); ++j) {
+    const int k = active_[j];
+    const Candidate& cand = all_[k];
+    const ProblemBlock& b = p.blocks[j];
+    const int o = b.first, at = first_[k];
+    for (int i = 0; i < b.rows(); ++i) {
+      const double P = p.P[o + i], umid = 0.5 * (uminus_[at + i] + p.u[o + i]);
+      (i >= 1 && i <= b.nf ? work_.friction : work_.impact) -= P * umid;
+      work_.support -= P * delassus_.b[at + i];
+      warm_[6 * k + i] = P;
+      const int row = i == 0 ? cand.normal : i <= b.nf ? cand.f[i - 1] : cand.e[i - 1 - b.nf];
+      lambda_[cdata.offset[cand.c] + row] = P / h;
+    }
+    if (!(p.P[o] > 0)) continue;
+    Mode mode = Mode::Stick;
+    if (b.nf > 0) {
+      const double pf = p.P.segment(o + 1, b.nf).norm();
+      const double slip = p.u.segment(o + 1, b.nf).norm();
+      if (pf >= (1 - 1e-6) * b.mu * p.P[o] && slip > 1e-9 * std::max(1.0, std::abs(p.u[o]))) mode = Mode::Slide;
+    }
+    modes_[cand.c] = mode;
+    rebound_[cand.c] = p.u[o] > std::max(1e-9, 0.5 * p.target[o]) ? 1 : 0;
+  }
+}
+
+}  // namespace appell::timestepping

@@ -1,0 +1,122 @@
+// The time-stepping stage of the simulator: Moreau–Jean steps for frictional
+// unilateral contacts (Jean, "The non-smooth contact dynamics method", CMAME
+// 177, 1999; Acary & Brogliato, "Numerical Methods for Nonsmooth Dynamical
+// Systems", Springer 2008, ch. 10). One step from (t, q, v) over h:
+//
+//   v_free = v + h v̇₀            v̇₀: the solver's acceleration with only the
+//                                 bilateral rows G closed (then projected
+//                                 onto G v + b = 0 at q)
+//   u      = J v + b             the candidate contacts' rows (normal,
+//                                 friction, ideal), u⁻ at v, u_free at v_free
+//   v⁺     = v_free + R P        R = (M⁻¹ − M⁻¹Gᵀ(GM⁻¹Gᵀ)⁺GM⁻¹) Jᵀ
+//   u⁺     = u_free + W P        W = J R, the Delassus operator
+//   q⁺     = q ⊕ h (θ v⁺ + (1 − θ) v)
+//
+// R's columns are the responses of the scene's own O(n) solver to unit
+// forces along the rows (delassus.cpp: m solves, each O(n)); P, the
+// impulses over the step, solve the contact problem (contact_problem.cpp):
+// per contact, Newton's restitution u⁺ₙ + e u⁻ₙ ≥ 0 ⊥ Pₙ ≥ 0 and Coulomb's
+// cone in De Saxcé's form; rows of μ = ∞ (ideal rolling) and custom rows
+// hold as equalities while the contact pushes. A contact is a candidate when
+// its gap closes within the step at the free velocity, g + h u_free,ₙ ≤ gap_tol.
+// Spin friction and regularized creep are the event scheme's: here spin rows
+// of a finite-μ contact are free and a creep contact is plain Coulomb.
+//
+// A stage in MuJoCo's sense: a function over (model, data, state) whose
+// workspace is sized once at construction; step() allocates nothing.
+#pragma once
+
+#include "timestepping/contact_problem.hpp"
+
+#include <appell/simulator.hpp>
+
+#include <string>
+#include <vector>
+
+namespace appell::timestepping {
+
+/// Throws std::invalid_argument naming the first option out of range.
+void checkOptions(const TimeSteppingOptions& options);
+
+/// What a contact did over the step: its impulse pushed (closed) or not,
+/// inside its cone (sticking) or on it (sliding).
+enum class Mode : signed char { Open, Stick, Slide };
+
+/// One unilateral constraint in the problem: where its rows are.
+struct Candidate {
+  int c = -1;             ///< constraint index
+  int normal = -1;        ///< the normal row in the constraint
+  int nf = 0, ne = 0;     ///< friction rows (finite μ) and equality rows
+  int f[3] = {-1, -1, -1};
+  int e[6] = {-1, -1, -1, -1, -1, -1};
+  double mu = 0, restitution = 0;
+  int rows() const { return 1 + nf + ne; }
+};
+
+/// The energy terms of one step (J), for the simulator's balance.
+struct StepWork {
+  double impact = 0;    ///< −Pₙ (u⁻ₙ + u⁺ₙ)/2 and the equality rows' part
+  double friction = 0;  ///< −Pₜ·(u⁻ₜ + u⁺ₜ)/2
+  double joint = 0;     ///< h τ·(v + v⁺)/2
+  double support = 0;   ///< −Pᵀb − h λᵀb: rows that move in time
+};
+
+class MoreauJean {
+ public:
+  MoreauJean(const Model& model, const ConstraintList& constraints, const TimeSteppingOptions& options,
+             double gap_tol);
+
+  /// One step from (t, q, v) over h: q, v become the end state (t + h is the
+  /// caller's). `cdata`'s active flags are overwritten (the caller sets them
+  /// from modes()). false with error() when a solve fails.
+  /// Approaches slower than `rest_speed` are plastic (as in the event scheme).
+  bool step(const Model& model, Data& data, const ConstraintList& constraints,
+            ConstraintData& cdata, ConstrainedSolver& solver,
+            const Simulator::JointForces& tau_fn, double t, VecX& q, VecX& v, double h,
+            double rest_speed);
+
+  const std::string& error() const { return error_; }
+  /// Per constraint: what it did over the last step (Open for bilateral ones).
+  const std::vector<Mode>& modes() const { return modes_; }
+  /// Per constraint: whether its normal velocity after the step separates
+  /// (a rebound): it is then not held by the drift projection.
+  bool rebounds(int c) const { return rebound_[c] != 0; }
+  const StepWork& work() const { return work_; }
+  /// Multipliers of the step as forces (m): the impulses over h on the
+  /// contact rows, the bilateral λ of the free solve on the others.
+  const VecX& lambda() const { return lambda_; }
+  const VecX& vdot() const { return vdot_; }
+  int sweeps() const { return problem_.sweeps; }
+  double residual() const { return problem_.residual; }
+  bool converged() const { return problem_.converged; }
+  /// Candidate contacts of the last step.
+  int candidates() const { return static_cast<int>(active_.size()); }
+
+ private:
+  bool freeVelocity(const Model& model, Data& data, const ConstraintList& constraints,
+                    ConstraintData& cdata, ConstrainedSolver& solver,
+                    const Simulator::JointForces& tau_fn, double t, const VecX& q,
+                    const VecX& v, double h);
+  void selectCandidates(const ConstraintData& cdata, double h, double rest_speed);
+  void finish(const ConstraintData& cdata, const VecX& v0, const VecX& v1, double h);
+
+  TimeSteppingOptions options_;
+  double gap_tol_;
+  std::vector<Candidate> all_;     ///< every unilateral constraint
+  std::vector<int> active_;        ///< indices into all_ of this step's candidates
+  std::vector<int> first_;         ///< per all_: first local row (−1: not a candidate)
+  std::vector<Mode> modes_;
+  std::vector<char> rebound_;
+  std::vector<double> warm_;       ///< per all_ (6 each): the last step's impulses
+  std::vector<int> map_;           ///< per problem row: its row in the Delassus J
+  int rows_ = 0;                   ///< rows of every candidate (J's layout)
+  ContactProblem problem_;
+  Delassus delassus_;
+  VecX uminus_, ufree_;            ///< every candidate row at v and at v_free
+  VecX tau_, vfree_, vdot_, lambda_, impulse_, v0_, qnext_;
+  ConstrainedResult res_, res2_;
+  StepWork work_;
+  std::string error_;
+};
+
+}  // namespace appell::timestepping
