@@ -49,6 +49,7 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
   builder.setGravity(gravity);
   std::map<std::string, int> body_of_link;
   Robot robot;
+  robot.warnings = urdf.warnings;
   MeshCache cache;
   for (const std::string& name : urdf.body_order) {
     const UrdfLink& link = urdf.links.at(name);

@@ -67,6 +67,9 @@ struct UrdfRobot {
   bool has_world = false;
   /// Links in depth-first order from the root (the root first), without "world".
   std::vector<std::string> body_order;
+  /// What reading tolerated, "file:line: <element>: reason" (a visual's
+  /// material that names no robot-level material); buildRobot passes them on.
+  std::vector<std::string> warnings;
 };
 
 /// Reads the <robot> element, checking as it goes: the version, names,
