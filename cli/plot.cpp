@@ -311,13 +311,14 @@ std::vector<std::string> writePlots(const std::string& csv, const std::string& d
     std::vector<std::vector<double>> cols = {t};
     std::string plot;
     for (size_t k = 0; k < paths.size(); ++k) {
-      names.push_back(paths[k].label + ".x");
-      names.push_back(paths[k].label + ".y");
-      cols.push_back(table.column(paths[k].x));
-      cols.push_back(table.column(paths[k].y));
+      const Path& p = paths[k];  // const: std::quoted(string&) would be a better match by ADL
+      names.push_back(p.label + ".x");
+      names.push_back(p.label + ".y");
+      cols.push_back(table.column(p.x));
+      cols.push_back(table.column(p.y));
       plot += std::string(k ? ", " : "plot ") + "'path.dat' using " + std::to_string(2 * k + 2) + ":" +
-              std::to_string(2 * k + 3) + " with lines " + paths[k].style + " lc " +
-              seriesColour(k, paths.size()) + " title " + quoted(paths[k].label);
+              std::to_string(2 * k + 3) + " with lines " + p.style + " lc " + seriesColour(k, paths.size()) +
+              " title " + quoted(p.label);
     }
     if (!plot.empty()) {
       writeData(dir / "path.dat", names, cols);
