@@ -284,12 +284,12 @@ TEST_F(CliPlot, ViewTakesARunWithoutJointLimits) {
   const fs::path csv = kWork / "free.csv", page = kWork / "free.html";
   ASSERT_EQ(sh("run " + car + " --no-joint-limits --duration 0.2 --quiet --out " + csv.string()).status, 0);
   const appell::TrajectoryTable table = appell::readTrajectory(csv.string());
-  for (const std::string& c : table.columns) ASSERT_EQ(c.find("steer_left"), std::string::npos) << c;
+  for (const std::string& c : table.columns) ASSERT_EQ(c.find("_limit"), std::string::npos) << c;
   const Result r = sh("view " + car + " --trajectory " + csv.string() + " --out " + page.string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("has no columns for the scene's"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(a run with --no-joint-limits): shown without them"), std::string::npos) << r.output;
-  EXPECT_EQ(slurp(page).find("\"name\":\"steer_left"), std::string::npos) << "no limit among the contacts";
+  EXPECT_EQ(slurp(page).find("\"name\":\"steer_left_lower_limit\""), std::string::npos) << "no limit";
   const Result flag = sh("view " + car + " --no-joint-limits --trajectory " + csv.string() + " --out " +
                          page.string());
   ASSERT_EQ(flag.status, 0) << flag.output;
@@ -300,7 +300,7 @@ TEST_F(CliPlot, ViewTakesARunWithoutJointLimits) {
   const Result with = sh("view " + car + " --trajectory " + limited.string() + " --out " + page.string());
   ASSERT_EQ(with.status, 0) << with.output;
   EXPECT_EQ(with.output.find("shown without them"), std::string::npos) << with.output;
-  EXPECT_NE(slurp(page).find("\"name\":\"steer_left"), std::string::npos) << "the limits are contacts";
+  EXPECT_NE(slurp(page).find("\"name\":\"steer_left_lower_limit\""), std::string::npos) << "the limits are there";
 }
 
 // A terrain support's triangles are in the page (in its support frame), as
