@@ -2,8 +2,9 @@
 // body poses the CLI computed (forward kinematics of each CSV sample, so
 // nothing is re-derived here), the contact points, the reaction forces
 // f = Σ_r λ_r d_r as arrows (d_r the row directions), the paths traced by the
-// bodies and the contacts, and a ground grid. Between samples, positions are
-// interpolated linearly and orientations by slerp.
+// bodies and the contacts, a ground grid and the supports (terrain meshes as
+// their triangles); visuals in their URDF material colours. Between samples,
+// positions are interpolated linearly and orientations by slerp.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
