@@ -15,10 +15,13 @@ Plots a trajectory that `appell run --out RUN.csv` wrote, with gnuplot:
   residuals.png   constraint residual per sample (log scale)
   contacts.png    normal load and friction demand |f_t|/f_n per contact (and μ)
   path.png        the paths of the joints' origins and of the contacts, from above
+  joints.png      q and v of each revolute, continuous and prismatic joint, and
+                  its applied force τ (efforts and servos; needs --scene)
 The .dat files gnuplot reads and its .gp scripts are written beside them.
 
   --out DIR             folder for the plots (default: RUN_plots beside RUN.csv)
   --scene SCENE.urdf    the run's scene: draws each contact's μ on contacts.png
+                        and the joints' applied forces τ on joints.png
   --package-path DIRS   colon/comma-separated folders for the scene's package:// meshes
 )";
 

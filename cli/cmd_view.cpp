@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 
 namespace appell::cli {
 
@@ -36,9 +37,12 @@ page loads nothing). Open it in a browser: play/pause, scrub, orbit with the mou
   --out PAGE.html       where to write the page (default: SCENE name + .html)
   --package-path DIRS   colon/comma-separated folders for package:// meshes
   --project-initial     project an initial state that violates the constraints
-)" APPELL_INERTIA_HELP R"(
+)" APPELL_INERTIA_HELP R"(  --no-joint-limits     leave out the URDF joint limits (as `run` does with it);
+                        a trajectory without the limits' columns (a run with
+                        --no-joint-limits) is shown without them in any case
+
 Page URL options (after #): t=2.5 (show that time), view=top (orthographic from
-above), center=x,y and span=S (top view framing, metres), play=1.
+above), center=x,y and span=S (top view framing, metres), play=1, contacts=0.
 )";
 
 /// The page's data as JSON, written by hand: numbers in the shortest form that
@@ -109,6 +113,15 @@ class Json {
   bool first_ = true;
 };
 
+/// The URDF material colour of a visual, when it has one: "rgba": [r, g, b, a]
+/// (sRGB components in [0, 1], as RViz reads them).
+void writeColour(Json& j, const Geometry& g) {
+  if (!g.rgba) return;
+  j.key("rgba").open('[');
+  for (const double c : *g.rgba) j.num(c);
+  j.close(']');
+}
+
 void writeGeometry(Json& j, const Geometry& g) {
   j.open('{').key("type");
   const Quat q(g.origin.R);
@@ -128,7 +141,20 @@ void writeGeometry(Json& j, const Geometry& g) {
     }
   }
   j.key("p").vec(g.origin.p).key("q").open('[').num(q.x()).num(q.y()).num(q.z()).num(q.w());
-  j.close(']').close('}');
+  j.close(']');
+  writeColour(j, g);
+  j.close('}');
+}
+
+/// A terrain support's triangles, in its support frame (the page places the
+/// frame per sample, as for the other supports): "vertices" x,y,z flat,
+/// "triangles" three indices each, in the mesh's winding (normals up).
+void writeTerrain(Json& j, const TerrainMesh& terrain) {
+  j.key("vertices").open('[');
+  for (const Vec3& v : terrain.vertices) j.num(v.x()).num(v.y()).num(v.z());
+  j.close(']').key("triangles").open('[');
+  for (const auto& t : terrain.triangles) j.num(t[0]).num(t[1]).num(t[2]);
+  j.close(']');
 }
 
 /// Radius of a ball about the body origin holding the geometry (frames the camera).
@@ -184,8 +210,26 @@ Frame frameAt(const Scene& scene, Data& data, std::vector<RowBlock>& blocks, dou
   return f;
 }
 
-std::vector<Frame> framesFromTrajectory(const Scene& scene, const std::string& path) {
-  const TrajectoryTable table = readTrajectory(path);
+/// A run with --no-joint-limits writes no columns for the limits. When the
+/// trajectory has none of them, the limits are left out of `scene` (as
+/// --no-joint-limits would) with a note, so `view` takes every CSV `run`
+/// writes; a file with some of the limits' columns but not all is refused
+/// later, naming the first missing column.
+void matchJointLimits(Scene& scene, const TrajectoryTable& table) {
+  if (scene.joint_limits.empty()) return;
+  for (const auto& limit : scene.joint_limits)
+    for (const std::string& c : table.columns)
+      if (c.rfind("lambda:" + limit->name() + ".", 0) == 0 || c == "closed:" + limit->name()) return;
+  std::set<const Constraint*> limits;
+  for (const auto& limit : scene.joint_limits) limits.insert(limit.get());
+  std::erase_if(scene.constraints, [&](const auto& c) { return limits.count(c.get()) > 0; });
+  std::cerr << "appell view: note: " << table.source << " has no columns for the scene's "
+            << scene.joint_limits.size() << " joint limits (a run with --no-joint-limits): "
+            << "shown without them\n";
+  scene.joint_limits.clear();
+}
+
+std::vector<Frame> framesFromTrajectory(const Scene& scene, const TrajectoryTable& table) {
   const Model& m = scene.model;
   const std::vector<std::string> names = trajectoryColumns(m, scene.constraints);
   // Columns in the writer's order: time, q (nq), v (nv), energy, residual, then per constraint.
@@ -235,6 +279,16 @@ std::vector<Frame> initialFrame(const Scene& scene) {
   return {frameAt(scene, data, blocks, 0.0, scene.q0, scene.v0, sim.lambda())};
 }
 
+/// The contacts that are one declaration's vertices (a sole's corners), so the
+/// overlay lists the declaration once: "vertexGroups": [{name, first, count}],
+/// contacts[first, first + count) (Scene::vertex_groups).
+void writeVertexGroups(Json& j, const Scene& scene) {
+  j.key("vertexGroups").open('[');
+  for (const VertexGroup& g : scene.vertex_groups)
+    j.open('{').key("name").str(g.name).key("first").num(g.first).key("count").num(g.count).close('}');
+  j.close(']');
+}
+
 /// Height of the first world-fixed horizontal plane (the grid goes there), NaN if none.
 double groundHeight(const Scene& scene) {
   for (const Support& s : scene.supports) {
@@ -267,9 +321,11 @@ std::string pageJson(const Scene& scene, const std::vector<Frame>& frames) {
   }
   j.close(']').key("contacts").open('[');
   for (const auto& c : scene.constraints) j.open('{').key("name").str(c->name()).close('}');
-  // Supports other than the ground (the grid stands for that one): planes and spheres.
+  j.close(']');
+  writeVertexGroups(j, scene);
+  // Supports other than the ground (the grid stands for that one): planes, spheres, terrains.
   const double ground = groundHeight(scene);
-  j.close(']').key("supports").open('[');
+  j.key("supports").open('[');
   for (const Support& s : scene.supports) {
     j.open('{').key("name").str(s.name).key("type");
     if (const Plane* p = std::get_if<Plane>(&s.surface)) {
@@ -281,7 +337,7 @@ std::string pageJson(const Scene& scene, const std::vector<Frame>& frames) {
       j.str("sphere").key("centre").vec(sp->centre).key("radius").num(sp->radius);
       j.key("inside").raw(sp->side == SphereSurface::Side::Inside ? "true" : "false");
     } else {
-      j.str("terrain");  // not drawn yet
+      writeTerrain(j.str("terrain"), std::get<TerrainMesh>(s.surface));
     }
     j.close('}');
   }
@@ -339,9 +395,15 @@ int view(int argc, char** argv) {
     throw std::runtime_error(
         "this appell was built without the viewer's three.js (viewer/node_modules is missing): "
         "run scripts/install-viewer-deps.sh, then rebuild");
-  const Scene scene = loadFromArgs(args, !args.has("trajectory"));
-  const std::vector<Frame> frames =
-      args.has("trajectory") ? framesFromTrajectory(scene, args.text("trajectory")) : initialFrame(scene);
+  Scene scene = loadFromArgs(args, !args.has("trajectory"));
+  std::vector<Frame> frames;
+  if (args.has("trajectory")) {
+    const TrajectoryTable table = readTrajectory(args.text("trajectory"));
+    matchJointLimits(scene, table);
+    frames = framesFromTrajectory(scene, table);
+  } else {
+    frames = initialFrame(scene);
+  }
   const std::string stem = std::filesystem::path(scene.source).stem().string();
   const std::string out = args.text("out", stem + ".html");
   refuseOverwritingInputs("out", out, scene,

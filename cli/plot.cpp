@@ -1,6 +1,9 @@
+// The plots of a run (plot.hpp): data files from the trajectory CSV, gnuplot
+// scripts beside them, and the PNGs gnuplot draws from them.
 #include "plot.hpp"
 
 #include <appell/constraint.hpp>
+#include <appell/output.hpp>
 #include <appell/trajectory_reader.hpp>
 
 #include <sys/wait.h>
@@ -9,7 +12,9 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -50,7 +55,7 @@ void writeData(const fs::path& path, const std::vector<std::string>& names,
 std::string header(const std::string& png, const std::string& title, int plots) {
   std::ostringstream gp;
   gp << "# Written by appell plot; redraw with: gnuplot " << fs::path(png).stem().string() << ".gp\n"
-     << "set encoding utf8\nset terminal pngcairo size 960," << (plots > 1 ? 760 : 560)
+     << "set encoding utf8\nset terminal pngcairo size 960," << (plots > 2 ? 960 : plots > 1 ? 760 : 560)
      << " noenhanced font 'sans,10'\nset output " << quoted(png) << "\nset grid\nset key outside right\nset lmargin 13\nset rmargin 24\n"
      << "set xlabel 't [s]'\n";
   if (plots > 1) gp << "set multiplot layout " << plots << ",1 title " << quoted(title) << "\n";
@@ -74,6 +79,34 @@ void runGnuplot(const fs::path& dir, const std::string& script) {
   if (code != 0)
     throw std::runtime_error("gnuplot failed on " + (dir / script).string() + " (exit " +
                              std::to_string(code) + ")");
+}
+
+/// Colour of curve k of n as gnuplot's "rgb '#rrggbb'", all n distinct. Up
+/// to 8 curves: Okabe & Ito's (2008, "Color Universal Design") colour-blind
+/// safe set, less its yellow, plus a grey; beyond 8 (gnuplot's own cycle
+/// repeats after 8): n hues evenly spaced round the HSV wheel, neighbours
+/// alternating between a bright and a dark shade. Distinct in 8-bit RGB
+/// while the hue step 1/n exceeds one 8-bit level of a channel (n < 1530).
+std::string seriesColour(size_t k, size_t n) {
+  static const char* kFew[] = {"#0072b2", "#d55e00", "#009e73", "#cc79a7",
+                               "#e69f00", "#56b4e9", "#000000", "#8a8a8a"};
+  if (n <= 8) return std::string("rgb '") + kFew[k] + "'";
+  const double h = 6.0 * static_cast<double>(k) / static_cast<double>(n), v = k % 2 ? 0.6 : 0.92;
+  const double f = h - std::floor(h), s = 0.85;
+  const double p = v * (1 - s), q = v * (1 - s * f), u = v * (1 - s * (1 - f));
+  double rgb[3];
+  switch (static_cast<int>(h) % 6) {
+    case 0: rgb[0] = v, rgb[1] = u, rgb[2] = p; break;
+    case 1: rgb[0] = q, rgb[1] = v, rgb[2] = p; break;
+    case 2: rgb[0] = p, rgb[1] = v, rgb[2] = u; break;
+    case 3: rgb[0] = p, rgb[1] = q, rgb[2] = v; break;
+    case 4: rgb[0] = u, rgb[1] = p, rgb[2] = v; break;
+    default: rgb[0] = v, rgb[1] = p, rgb[2] = q; break;
+  }
+  char hex[16];
+  std::snprintf(hex, sizeof hex, "#%02x%02x%02x", static_cast<int>(std::lround(255 * rgb[0])),
+                static_cast<int>(std::lround(255 * rgb[1])), static_cast<int>(std::lround(255 * rgb[2])));
+  return std::string("rgb '") + hex + "'";
 }
 
 struct ContactColumns {
@@ -105,6 +138,77 @@ std::vector<ContactColumns> contactColumns(const TrajectoryTable& table) {
     }
   }
   return out;
+}
+
+/// The one-degree-of-freedom joints (revolute, continuous, prismatic): a
+/// "q:<joint>" column with a "v:<joint>" of the same name (planar and
+/// floating joints have suffixed coordinates, drawn on path.png).
+std::vector<std::string> scalarJoints(const TrajectoryTable& table) {
+  std::vector<std::string> joints;
+  for (const std::string& col : table.columns)
+    if (col.rfind("q:", 0) == 0 && table.find("v:" + col.substr(2)) >= 0) joints.push_back(col.substr(2));
+  return joints;
+}
+
+/// τ of each joint at every sample: the scene's constant efforts plus its
+/// servos (Scene::jointForces) evaluated at the sample's (t, q, v); the
+/// trajectory must be the scene's (all its q and v columns).
+std::vector<std::vector<double>> jointEfforts(const TrajectoryTable& table, const Scene& scene,
+                                              const std::vector<std::string>& joints) {
+  const Model& m = scene.model;
+  std::vector<int> qcol, vcol, slot;
+  for (const std::string& n : coordinateNames(m, false)) qcol.push_back(table.require("q:" + n));
+  for (const std::string& n : coordinateNames(m, true)) vcol.push_back(table.require("v:" + n));
+  for (const std::string& j : joints) {
+    const int b = m.jointIndex(j);
+    if (b < 0) throw std::runtime_error(table.source + ": joint '" + j + "' is not in the scene " + scene.source);
+    slot.push_back(m.joints[b].idx_v);
+  }
+  const Simulator::JointForces forces = scene.jointForces();
+  std::vector<std::vector<double>> tau(joints.size(), std::vector<double>(table.rows.size()));
+  VecX q(m.nq), v(m.nv), out(m.nv);
+  for (size_t i = 0; i < table.rows.size(); ++i) {
+    for (int k = 0; k < m.nq; ++k) q[k] = table.rows[i][qcol[k]];
+    for (int k = 0; k < m.nv; ++k) v[k] = table.rows[i][vcol[k]];
+    out.setZero();
+    forces(table.rows[i][0], q, v, out);
+    for (size_t j = 0; j < joints.size(); ++j) tau[j][i] = out[slot[j]];
+  }
+  return tau;
+}
+
+/// joints.dat and the script of joints.png: q and v of every one-degree-of-
+/// freedom joint, and its applied force τ when the scene is known and drives
+/// joints; nothing when the model has no such joint.
+std::optional<std::string> jointPlot(const TrajectoryTable& table, const fs::path& dir, const std::string& run,
+                                     const Scene* scene) {
+  const std::vector<std::string> joints = scalarJoints(table);
+  if (joints.empty()) return std::nullopt;
+  const bool efforts = scene && scene->driven();
+  std::vector<std::string> names = {"t"};
+  std::vector<std::vector<double>> cols = {table.column(0)};
+  for (const std::string& j : joints) {
+    names.insert(names.end(), {"q:" + j, "v:" + j});
+    cols.push_back(table.column(table.require("q:" + j)));
+    cols.push_back(table.column(table.require("v:" + j)));
+  }
+  if (efforts)
+    for (std::vector<double>& tau : jointEfforts(table, *scene, joints)) cols.push_back(std::move(tau));
+  for (size_t j = 0; efforts && j < joints.size(); ++j) names.push_back("tau:" + joints[j]);
+  writeData(dir / "joints.dat", names, cols);
+  const size_t n = joints.size(), stride = 2;
+  auto panel = [&](const std::string& ylabel, auto column) {
+    std::string p = "set ylabel " + quoted(ylabel) + "\nplot ";
+    for (size_t k = 0; k < n; ++k)
+      p += std::string(k ? ", " : "") + "'joints.dat' using 1:" + std::to_string(column(k)) +
+           " with lines lw 2 lc " + seriesColour(k, n) + " title " + quoted(joints[k]);
+    return p + "\n";
+  };
+  std::string script = header("joints.png", "joints — " + run, efforts ? 3 : 2);
+  script += panel("q [rad or m]", [&](size_t k) { return 2 + stride * k; });
+  script += panel("v [rad/s or m/s]", [&](size_t k) { return 3 + stride * k; });
+  if (efforts) script += panel("τ [N·m or N]", [&](size_t k) { return 2 + stride * n + k; });
+  return script + "unset multiplot\n";
 }
 
 }  // namespace
@@ -171,16 +275,16 @@ std::vector<std::string> writePlots(const std::string& csv, const std::string& d
       cols.push_back(fn);
       cols.push_back(demand);
       const std::string sep = k ? ", " : "";
-      const int lc = static_cast<int>(k) + 1;
+      const std::string lc = seriesColour(k, loaded.size());
       load_plot += sep + "'contacts.dat' using 1:" + std::to_string(2 + 2 * k) +
-                   " with lines lw 2 lc " + std::to_string(lc) + " title " + quoted(c.name);
+                   " with lines lw 2 lc " + lc + " title " + quoted(c.name);
       demand_plot += sep + "'contacts.dat' using 1:" + std::to_string(3 + 2 * k) +
-                     " with lines lw 2 lc " + std::to_string(lc) + " title " + quoted(c.name);
+                     " with lines lw 2 lc " + lc + " title " + quoted(c.name);
       const int ci = scene ? scene->contactIndex(c.name) : -1;
       if (ci >= 0 && std::isfinite(scene->contacts[ci]->mu())) {
         char mu[32];
         *std::to_chars(mu, mu + sizeof mu - 1, scene->contacts[ci]->mu()).ptr = 0;
-        demand_plot += ", " + std::string(mu) + " with lines dt 2 lw 2 lc " + std::to_string(lc) +
+        demand_plot += ", " + std::string(mu) + " with lines dt 2 lw 2 lc " + lc +
                        " title " + quoted("μ " + c.name + " = " + mu);
       }
     }
@@ -192,34 +296,37 @@ std::vector<std::string> writePlots(const std::string& csv, const std::string& d
   }
   // Paths from above: joint origins with an x and a y, and contact points.
   {
-    std::vector<std::string> names = {"t"};
-    std::vector<std::vector<double>> cols = {t};
-    std::string plot;
-    auto add = [&](const std::string& label, int x, int y, const std::string& style) {
-      if (x < 0 || y < 0) return;
-      names.push_back(label + ".x");
-      names.push_back(label + ".y");
-      cols.push_back(table.column(x));
-      cols.push_back(table.column(y));
-      const size_t k = cols.size() - 2;
-      plot += std::string(plot.empty() ? "plot " : ", ") + "'path.dat' using " +
-              std::to_string(k + 1) + ":" + std::to_string(k + 2) + " with lines " + style +
-              " title " + quoted(label);
-    };
+    struct Path { std::string label; int x, y; const char* style; };
+    std::vector<Path> paths;
     for (size_t i = 0; i < table.columns.size(); ++i) {
       const std::string& col = table.columns[i];
       if (col.rfind("q:", 0) == 0 && col.size() > 4 && col.compare(col.size() - 2, 2, ".x") == 0) {
         const std::string joint = col.substr(2, col.size() - 4);
-        add(joint, static_cast<int>(i), table.find("q:" + joint + ".y"), "lw 2");
+        paths.push_back({joint, static_cast<int>(i), table.find("q:" + joint + ".y"), "lw 2"});
       }
     }
-    for (const ContactColumns& c : contacts) add("contact " + c.name, c.px, c.py, "lw 1 dt 3");
+    for (const ContactColumns& c : contacts) paths.push_back({"contact " + c.name, c.px, c.py, "lw 1 dt 3"});
+    std::erase_if(paths, [](const Path& p) { return p.x < 0 || p.y < 0; });
+    std::vector<std::string> names = {"t"};
+    std::vector<std::vector<double>> cols = {t};
+    std::string plot;
+    for (size_t k = 0; k < paths.size(); ++k) {
+      const Path& p = paths[k];  // const: std::quoted(string&) would be a better match by ADL
+      names.push_back(p.label + ".x");
+      names.push_back(p.label + ".y");
+      cols.push_back(table.column(p.x));
+      cols.push_back(table.column(p.y));
+      plot += std::string(k ? ", " : "plot ") + "'path.dat' using " + std::to_string(2 * k + 2) + ":" +
+              std::to_string(2 * k + 3) + " with lines " + p.style + " lc " + seriesColour(k, paths.size()) +
+              " title " + quoted(p.label);
+    }
     if (!plot.empty()) {
       writeData(dir / "path.dat", names, cols);
       draw("path", header("path.png", "path seen from above — " + run, 1) +
                        "set size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n" + plot + "\n");
     }
   }
+  if (std::optional<std::string> script = jointPlot(table, dir, run, scene)) draw("joints", *script);
   return pngs;
 }
 

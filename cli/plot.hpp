@@ -8,6 +8,10 @@
 //                  by Coulomb's law; drawn when a scene gives μ)
 //   path.png       the paths seen from above: planar/floating joint origins
 //                  (q:<joint>.x, .y) and the contact points (point:<c>.x, .y)
+//   joints.png     q and v of every one-degree-of-freedom joint, and its
+//                  applied force τ (constant efforts + servos, evaluated at
+//                  each sample) when the scene is given and drives joints
+// Curves get distinct colours however many there are (seriesColour).
 // The .dat and .gp files stay beside the PNGs, so a plot can be redrawn or
 // restyled with `gnuplot NAME.gp` in that folder.
 #pragma once
@@ -20,7 +24,8 @@
 namespace appell::cli {
 
 /// Writes the data, scripts and PNGs into `dir` (created if needed) and returns
-/// the PNG paths. `scene` (may be null) supplies μ per contact, by name.
+/// the PNG paths. `scene` (may be null) supplies μ per contact, by name, and
+/// the joint forces τ.
 /// Throws std::runtime_error when the CSV cannot be read or gnuplot fails.
 std::vector<std::string> writePlots(const std::string& csv, const std::string& dir,
                                     const Scene* scene);

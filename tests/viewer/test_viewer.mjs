@@ -9,17 +9,23 @@
 // q:root_joint.x/.y of the sample (to within 1.5 px: anti-aliased edges).
 // The red force arrow must stand on the contact point (point:rim.x/.y) and
 // vanish with #contacts=0, and the two times must give different pictures.
+// Then a car over a bump (examples/car_bump) with URDF materials added: the
+// terrain mesh must be drawn (its colour where the ground is) and the
+// chassis and wheels in their materials' colours. Last, the tumbling crate
+// at rest: the overlay (read from the page's DOM) lists its 8 corner contacts
+// as one line with the net force, its weight.
 //
 // usage: node test_viewer.mjs APPELL SOURCE_DIR WORK_DIR      (exit 77: skipped)
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdirSync, readFileSync, rmSync } from 'node:fs';
+import { copyFileSync, existsSync, mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { inflateSync } from 'node:zlib';
 import { join } from 'node:path';
 
 const [appell, source, work] = process.argv.slice(2);
-let failures = 0;
+let failures = 0, checks = 0;
 function check(ok, what) {
   console.log(`${ok ? 'ok  ' : 'FAIL'}  ${what}`);
+  ++checks;
   if (!ok) ++failures;
 }
 
@@ -109,9 +115,9 @@ const cx = (Math.min(...xs) + Math.max(...xs)) / 2, cy = (Math.min(...ys) + Math
 const span = 1.5 * Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys)) + 1.5;
 const W = 800, H = 800;
 
-function shoot(t, extra, name) {
+function shoot(t, extra, name, at = { page, cx, cy, span }) {
   const png = join(work, name);
-  const url = `file://${page}#t=${t}&view=top&center=${cx},${cy}&span=${span}${extra}`;
+  const url = `file://${at.page}#t=${t}&view=top&center=${at.cx},${at.cy}&span=${at.span}${extra}`;
   execFileSync(chromium, ['--headless', '--no-sandbox', '--disable-gpu', '--use-angle=swiftshader',
     '--enable-unsafe-swiftshader', '--disable-quic', '--no-first-run', '--disable-background-networking',
     '--disable-component-update', '--disable-sync', '--hide-scrollbars', `--user-data-dir=${join(work, 'profile')}`,
@@ -119,8 +125,8 @@ function shoot(t, extra, name) {
     { stdio: 'ignore', timeout: 120000 });
   return readPng(png);
 }
-const toPixel = (x, y, img) => ({ x: img.width / 2 + (x - cx) * img.width / span,
-                                  y: img.height / 2 - (y - cy) * img.width / span });
+const toPixel = (x, y, img, at = { cx, cy, span }) => ({ x: img.width / 2 + (x - at.cx) * img.width / at.span,
+                                                         y: img.height / 2 - (y - at.cy) * img.width / at.span });
 
 // Two samples of the CSV (exact sample times: the page then shows the sample itself).
 const samples = [Math.floor(rows.length * 0.3), Math.floor(rows.length * 0.8)];
@@ -153,5 +159,67 @@ for (let y = 0; y < H; ++y)
   }
 check(differ > 500, `the two times give different pictures (${differ} pixels differ)`);
 
-console.log(`${samples.length * 4 + 2 - failures} passed, ${failures} failed`);
+// ---- a terrain and URDF materials: examples/car_bump (a car over a bump in a
+// terrain mesh), its chassis given a robot-level material by name and its
+// wheels a colour of their own, as URDF allows.
+{
+  const car = join(source, 'examples/car_bump');
+  const urdf = readFileSync(join(car, 'car_bump.urdf'), 'utf8')
+    .replace('<robot name="car_bump">',
+             '<robot name="car_bump">\n  <material name="paint"><color rgba="0.1 0.3 0.85 1"/></material>')
+    .replace('<geometry><box size="1.0 0.6 0.2"/></geometry>\n    </visual>',
+             '<geometry><box size="1.0 0.6 0.2"/></geometry>\n      <material name="paint"/>\n    </visual>')
+    .replaceAll('<geometry><cylinder radius="0.15" length="0.06"/></geometry>\n    </visual>',
+                '<geometry><cylinder radius="0.15" length="0.06"/></geometry>\n' +
+                '      <material name="tyre"><color rgba="0.1 0.1 0.1 1"/></material>\n    </visual>');
+  check((urdf.match(/<material name="(paint|tyre)"/g) || []).length === 6, 'the test scene has its 6 materials');
+  copyFileSync(join(car, 'bump.obj'), join(work, 'bump.obj'));
+  const scene2 = join(work, 'car_bump.urdf'), csv2 = join(work, 'car.csv'), page2 = join(work, 'car.html');
+  writeFileSync(scene2, urdf);
+  execFileSync(appell, ['run', scene2, '--duration', '0.5', '--quiet', '--out', csv2]);
+  execFileSync(appell, ['view', scene2, '--trajectory', csv2, '--out', page2]);
+  const l2 = readFileSync(csv2, 'utf8').trim().split('\n'), c2 = l2[0].split(',');
+  const last = l2[l2.length - 1].split(',').map(Number);
+  const [x, y] = ['q:root_joint.x', 'q:root_joint.y'].map((n) => last[c2.indexOf(n)]);
+  // From above: the whole bump (x 2 … 3.5 m) and the car, 6 m across.
+  const at = { page: page2, cx: 2, cy: 0, span: 6 };
+  const img = shoot(last[0], '&contacts=0', 'car_top.png', at);
+  const rgb = (wx, wy) => { const p = toPixel(wx, wy, img, at); return [...img.at(Math.round(p.x), Math.round(p.y))]; };
+  // The terrain's sand colour (0xc8b07a) under any shading: red over green over a blue
+  // that is still present (not the disk's orange, not the grey background).
+  const isTerrain = (r, g, b) => r > 90 && r - b > 35 && g - b > 20 && b > 0.35 * r;
+  const ground = [[-0.5, 1.2], [1.5, -2.2], [2.25, 1.8], [3.25, -1.5], [4.5, 2.2]];
+  const terrainAt = ground.filter(([wx, wy]) => isTerrain(...rgb(wx, wy)));
+  check(terrainAt.length === ground.length,
+        `terrain pixels where the mesh is (${terrainAt.length}/${ground.length}: ` +
+        ground.map(([wx, wy]) => `(${wx}, ${wy}) → ${rgb(wx, wy)}`).join(', ') + ')');
+  const terrainPixels = centroid(img, isTerrain).n;
+  check(terrainPixels > 0.5 * img.width * img.height, `the terrain covers the ground (${terrainPixels} pixels)`);
+  // The chassis (its centre 0.1 m ahead of the root) in the robot-level colour.
+  const paint = rgb(x + 0.1, y), [r, g, b] = paint;
+  check(b > 120 && b > 2 * r && b > 1.4 * g, `the chassis is drawn in its material's blue (${paint} at x = ${x.toFixed(3)} m)`);
+  // A wheel's top, in its own near-black.
+  const tyre = rgb(x + 0.4, y + 0.35);
+  check(Math.max(...tyre) < 70, `the front left wheel is drawn in its own colour (${tyre})`);
+}
+
+// ---- the overlay lists a shape's vertex contacts as one line: the tumbling
+// crate (examples/tumbling_crate, 3 kg, its box's 8 corners as contacts) at
+// rest on a face: 4 corners closed, carrying its weight 3 g = 29.430 N.
+{
+  const crate = join(source, 'examples/tumbling_crate/tumbling_crate.urdf');
+  const csv3 = join(work, 'crate.csv'), page3 = join(work, 'crate.html');
+  execFileSync(appell, ['run', crate, '--quiet', '--out', csv3]);
+  execFileSync(appell, ['view', crate, '--trajectory', csv3, '--out', page3]);
+  const dom = execFileSync(chromium, ['--headless', '--no-sandbox', '--disable-gpu', '--use-angle=swiftshader',
+    '--enable-unsafe-swiftshader', '--no-first-run', '--disable-background-networking', '--disable-component-update',
+    '--disable-sync', `--user-data-dir=${join(work, 'profile')}`, '--window-size=800,800',
+    '--virtual-time-budget=3000', '--dump-dom', `file://${page3}#t=1e9`],
+    { encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'], timeout: 120000 });
+  const info = (dom.match(/<div id="info">([^<]*)<\/div>/) || [, ''])[1];
+  check(/^corners \(8 vertices, 4 closed\): \|Σf\| = 29\.430 N$/m.test(info) && !info.includes('corners/v'),
+        `the crate's corners are one line of the overlay (${JSON.stringify(info)})`);
+}
+
+console.log(`${checks - failures} passed, ${failures} failed`);
 process.exit(failures ? 1 : 0);

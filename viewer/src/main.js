@@ -2,8 +2,9 @@
 // body poses the CLI computed (forward kinematics of each CSV sample, so
 // nothing is re-derived here), the contact points, the reaction forces
 // f = Σ_r λ_r d_r as arrows (d_r the row directions), the paths traced by the
-// bodies and the contacts, and a ground grid. Between samples, positions are
-// interpolated linearly and orientations by slerp.
+// bodies and the contacts, a ground grid and the supports (terrain meshes as
+// their triangles); visuals in their URDF material colours. Between samples,
+// positions are interpolated linearly and orientations by slerp.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
@@ -44,9 +45,36 @@ data.supports.forEach((s, k) => {              // a bowl or a globe: frame all o
 const centre = box.getCenter(new THREE.Vector3());
 const extent = Math.max(box.getSize(new THREE.Vector3()).length(), 1e-3);
 
+// ---- terrain meshes: their triangles, in the support frame (placed per sample
+// below, as every support); flat-shaded faces in a sand colour, with the
+// creases (faces meeting at more than 1°) and the boundary drawn as lines.
+const terrainColour = 0xc8b07a;
+function terrainMesh(s) {
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.Float32BufferAttribute(s.vertices, 3));
+  g.setIndex(s.triangles);
+  const faces = g.toNonIndexed();                 // one normal per face: flat shading
+  faces.computeVertexNormals();
+  const group = new THREE.Group();
+  group.add(new THREE.Mesh(faces, new THREE.MeshLambertMaterial({
+    color: terrainColour, side: THREE.DoubleSide, polygonOffset: true, polygonOffsetFactor: 1,
+    polygonOffsetUnits: 1 })));
+  group.add(new THREE.LineSegments(new THREE.EdgesGeometry(g, 1),
+                                   new THREE.LineBasicMaterial({ color: 0x7d6a45 })));
+  return group;
+}
+// Lowest world z of the terrains at the first sample (the grid goes under them).
+let terrainBottom = Infinity;
+data.supports.forEach((s, k) => {
+  if (s.type !== 'terrain') return;
+  const o = data.supportPoses[0], r = new THREE.Quaternion().fromArray(o, 7 * k + 3), v = new THREE.Vector3();
+  for (let i = 0; i < s.vertices.length; i += 3)
+    terrainBottom = Math.min(terrainBottom, v.fromArray(s.vertices, i).applyQuaternion(r).z + o[7 * k + 2]);
+});
+
 // ---- ground grid: in the scene's horizontal ground plane, else under everything
 {
-  const z = data.ground !== null ? data.ground : box.min.z;
+  const z = data.ground !== null ? data.ground : Math.min(box.min.z, terrainBottom - 1e-3 * extent);
   const n = Math.ceil(extent / 0.5) * 2;
   const grid = new THREE.GridHelper(n * 0.5, n, 0x9a9a9a, 0xcfcfcf);
   grid.rotation.x = Math.PI / 2;                  // GridHelper lies in xz
@@ -75,11 +103,19 @@ function geometryOf(g) {
   }
   throw new Error('unknown geometry ' + g.type);
 }
+// A visual's URDF material colour (sRGB, as RViz shows it; alpha < 1 see-through),
+// else the body's colour from the palette.
+function materialOf(g, fallback) {
+  if (!g.rgba) return fallback;
+  const [r, gr, b, a] = g.rgba;
+  return new THREE.MeshLambertMaterial({ color: new THREE.Color().setRGB(r, gr, b, THREE.SRGBColorSpace),
+                                         transparent: a < 1, opacity: a });
+}
 const bodies = data.bodies.map((body, b) => {
   const group = new THREE.Group();
   const material = new THREE.MeshLambertMaterial({ color: palette[b % palette.length] });
   for (const g of body.geometry) {
-    const mesh = new THREE.Mesh(geometryOf(g), material);
+    const mesh = new THREE.Mesh(geometryOf(g), materialOf(g, material));
     mesh.position.fromArray(g.p);
     mesh.quaternion.fromArray(g.q);
     group.add(mesh);
@@ -89,7 +125,8 @@ const bodies = data.bodies.map((body, b) => {
 });
 
 // ---- supports other than the ground: a disc with spokes for a plane (so that
-// a turntable's turn shows), a wire sphere for a globe or a bowl; each in its
+// a turntable's turn shows), a wire sphere for a globe or a bowl, the
+// triangles of a terrain; each in its
 // support frame, placed per sample (moving supports, supports on bodies)
 const supportMaterial = new THREE.LineBasicMaterial({ color: 0x6a7f99, transparent: true, opacity: 0.7 });
 const supports = data.supports.map((s) => {
@@ -107,6 +144,8 @@ const supports = data.supports.map((s) => {
     const wire = new THREE.LineSegments(new THREE.WireframeGeometry(g), supportMaterial);
     wire.position.fromArray(s.centre);
     group.add(wire);
+  } else if (s.type === 'terrain') {
+    group.add(terrainMesh(s));
   }
   scene.add(group);
   return group;
@@ -143,6 +182,13 @@ const contacts = data.contacts.map(() => {
   if (opts.contacts !== '0') scene.add(dot, arrow);   // contacts=0: the bodies alone
   return { dot, arrow };
 });
+
+// ---- the overlay lists a shape's vertex contacts (a box's corners, a sole's
+// rim) as one line: the declaration, how many vertices touch, and the net
+// force Σf they carry
+const vertexGroups = data.vertexGroups || [];
+const groupOf = new Array(nc).fill(-1);
+vertexGroups.forEach((g, k) => { for (let c = g.first; c < g.first + g.count; ++c) groupOf[c] = k; });
 
 // ---- cameras: a perspective one the mouse orbits, or a fixed one from above
 const aspect = host.clientWidth / host.clientHeight;
@@ -198,7 +244,7 @@ function show(t) {
     supports[k].position.copy(p0);
     supports[k].quaternion.copy(q0);
   }
-  const lines = [];
+  const lines = [], groupSum = vertexGroups.map(() => ({ f: new THREE.Vector3(), closed: 0 }));
   for (let c = 0; c < nc; ++c) {
     lerp3(p0, data.points[i], data.points[j], 3 * c, w);
     lerp3(f, data.forces[i], data.forces[j], 3 * c, w);
@@ -214,7 +260,17 @@ function show(t) {
       a.setDirection(f.clone().normalize());
       a.setLength(len, Math.min(0.3 * len, 0.04 * extent), Math.min(0.15 * len, 0.02 * extent));
     }
-    lines.push(`${data.contacts[c].name}: ` + (closed ? `|f| = ${f.length().toFixed(3)} N` : 'open'));
+    const k = groupOf[c];
+    if (k >= 0) {                               // one of a declaration's vertices: summed below
+      if (closed) { groupSum[k].f.add(f); ++groupSum[k].closed; }
+      if (c === vertexGroups[k].first) lines.push(k);   // its line goes where its first vertex is
+    } else lines.push(`${data.contacts[c].name}: ` + (closed ? `|f| = ${f.length().toFixed(3)} N` : 'open'));
+  }
+  for (let l = 0; l < lines.length; ++l) {
+    if (typeof lines[l] !== 'number') continue;
+    const g = vertexGroups[lines[l]], sum = groupSum[lines[l]];
+    lines[l] = `${g.name} (${g.count} vertices, ${sum.closed} closed): ` +
+      (sum.closed ? `|Σf| = ${sum.f.length().toFixed(3)} N` : 'open');
   }
   const drawn = Math.max(2, i + 2);
   for (const p of paths) p.geometry.setDrawRange(0, Math.min(drawn, ns));

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -53,6 +54,10 @@ struct Geometry {
   std::string mesh_path;          ///< mesh: resolved absolute path
   Vec3 mesh_scale = Vec3::Ones(); ///< mesh: the scale applied to `mesh`
   std::shared_ptr<const TriangleMesh> mesh;  ///< mesh: triangles (scaled); null if not loaded
+  /// Visual: the URDF `<material>` colour (r, g, b, a in [0, 1]) — the
+  /// visual's own `<color rgba>`, else that of the robot-level material it
+  /// names; none when the visual has no material or only a texture.
+  std::optional<std::array<double, 4>> rgba;
 };
 
 /// Geometry of one link. Links map one-to-one to model bodies.

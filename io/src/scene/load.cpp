@@ -25,9 +25,9 @@ Scene loadSceneFromString(const std::string& xml, const std::string& base_dir,
   Scene scene;
   scene.model = std::move(parsed.model);
   scene.geometry = std::move(parsed.geometry);
-  // Warnings in the order the loader met them: the URDF, its meshes, the block.
-  scene.warnings = urdf.warnings;
-  scene.warnings.insert(scene.warnings.end(), parsed.warnings.begin(), parsed.warnings.end());
+  // Warnings in the order the loader met them: the snap, the URDF (buildRobot
+  // carries the reader's), its meshes and inertias, the block.
+  scene.warnings = parsed.warnings;
   scene.warnings.insert(scene.warnings.end(), block.warnings.begin(), block.warnings.end());
   scene.source = name;
   io::buildSceneContents(src, urdf, block, options, scene);

@@ -113,6 +113,7 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
   builder.setInertiaRepairs(repairs);
   std::map<std::string, int> body_of_link;
   Robot robot;
+  robot.warnings = urdf.warnings;
   MeshCache cache;
   WarningTally uri_notes("mesh URIs like it"), unused_missing("collision meshes no contact uses");
   for (const std::string& name : urdf.body_order) {

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <map>
 #include <set>
 #include <vector>
 #include <sstream>
@@ -161,6 +162,10 @@ const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
 
 namespace {
 
+using Rgba = std::array<double, 4>;
+/// Robot-level materials by name: their colour (none for a texture-only one).
+using MaterialColours = std::map<std::string, std::optional<Rgba>>;
+
 // URDF 1.0 is the only version there is; urdfdom rejects any other, and
 // so does this loader. The attribute is "<major>.<minor>", both integers.
 void checkVersion(const XmlSource& src, const TiXmlElement* robot) {
@@ -213,15 +218,36 @@ Inertia readInertial(const XmlSource& src, const TiXmlElement* inertial) {
 
 // <color rgba> must be four numbers in [0, 1]; a top-level <material> must define a
 // colour or a texture (a <material> inside <visual> may only name one).
-void checkMaterial(const XmlSource& src, const TiXmlElement* material, bool top_level) {
+// Returns the colour, if the material gives one.
+std::optional<Rgba> checkMaterial(const XmlSource& src, const TiXmlElement* material, bool top_level) {
   text(src, material, "name");
   const TiXmlElement* color = material->FirstChildElement("color");
-  if (color)
-    for (double c : numbers(src, color, "rgba", 4))
-      if (c < 0 || c > 1) fail(src, color, "colour components must lie in [0, 1]");
+  std::optional<Rgba> rgba;
+  if (color) {
+    const std::vector<double> c = numbers(src, color, "rgba", 4);
+    for (double x : c)
+      if (x < 0 || x > 1) fail(src, color, "colour components must lie in [0, 1]");
+    rgba = Rgba{c[0], c[1], c[2], c[3]};
+  }
   const TiXmlElement* texture = material->FirstChildElement("texture");
   if (top_level && !color && !(texture && has(texture, "filename")))
     fail(src, material, "a material needs a <color rgba> or a <texture filename>");
+  return rgba;
+}
+
+// A visual's colour, as URDF resolves it: its <material>'s own <color>, else
+// the robot-level material of that name. A name defined nowhere is drawn in
+// the default colour, with a warning (urdfdom refuses the file; RViz users
+// meet such files after a xacro that dropped the materials' include).
+std::optional<Rgba> visualColour(const XmlSource& src, const TiXmlElement* material,
+                                 const MaterialColours& materials, std::vector<std::string>& warnings) {
+  if (std::optional<Rgba> own = checkMaterial(src, material, false)) return own;
+  const std::string name = material->Attribute("name");
+  if (const auto it = materials.find(name); it != materials.end()) return it->second;
+  warnings.push_back(src.file + (material->Row() > 0 ? ":" + std::to_string(material->Row()) : "") +
+                     ": " + describe(material) + ": material '" + name +
+                     "' is not defined at the robot level: drawn in the default colour");
+  return std::nullopt;
 }
 
 UrdfGeometry readGeometry(const XmlSource& src, const TiXmlElement* holder) {
@@ -264,7 +290,8 @@ UrdfGeometry readGeometry(const XmlSource& src, const TiXmlElement* holder) {
   return out;
 }
 
-UrdfLink readLink(const XmlSource& src, const TiXmlElement* l) {
+UrdfLink readLink(const XmlSource& src, const TiXmlElement* l, const MaterialColours& materials,
+                  std::vector<std::string>& warnings) {
   UrdfLink link;
   link.element = l;
   link.name = text(src, l, "name");
@@ -276,7 +303,8 @@ UrdfLink readLink(const XmlSource& src, const TiXmlElement* l) {
   }
   for (const TiXmlElement* v = l->FirstChildElement("visual"); v; v = v->NextSiblingElement("visual")) {
     link.visual.push_back(readGeometry(src, v));
-    if (const TiXmlElement* m = v->FirstChildElement("material")) checkMaterial(src, m, false);
+    if (const TiXmlElement* m = v->FirstChildElement("material"))
+      link.visual.back().geometry.rgba = visualColour(src, m, materials, warnings);
   }
   for (const TiXmlElement* c = l->FirstChildElement("collision"); c;
        c = c->NextSiblingElement("collision"))
@@ -424,17 +452,17 @@ UrdfRobot readUrdf(const XmlSource& src, const TiXmlElement* robot) {
   if (text(robot, "name", "").empty()) fail(src, robot, "the robot has no name");
   checkVersion(src, robot);
 
-  std::set<std::string> materials;
+  MaterialColours materials;
   for (const TiXmlElement* m = robot->FirstChildElement("material"); m;
        m = m->NextSiblingElement("material")) {
-    checkMaterial(src, m, true);
-    if (!materials.insert(m->Attribute("name")).second)
+    const std::optional<Rgba> rgba = checkMaterial(src, m, true);
+    if (!materials.emplace(m->Attribute("name"), rgba).second)
       fail(src, m, "material name '" + std::string(m->Attribute("name")) + "' is used twice");
   }
 
   for (const TiXmlElement* l = robot->FirstChildElement("link"); l;
        l = l->NextSiblingElement("link")) {
-    UrdfLink link = readLink(src, l);
+    UrdfLink link = readLink(src, l, materials, ix.warnings);
     if (ix.links.count(link.name)) fail(src, l, "link name '" + link.name + "' is used twice");
     ix.link_order.push_back(link.name);
     ix.links.emplace(link.name, std::move(link));

@@ -68,7 +68,8 @@ struct UrdfRobot {
   bool has_world = false;
   /// Links in depth-first order from the root (the root first), without "world".
   std::vector<std::string> body_order;
-  /// What the reader tolerated and how ("file:line: <element>: …"), for Scene::warnings.
+  /// What the reader tolerated and how, "file:line: <element>: reason" (e.g. a
+  /// visual's material that names no robot-level material), for Scene::warnings.
   std::vector<std::string> warnings;
 };
 
