@@ -217,7 +217,8 @@ TEST(Published, ABoxDeclaredInTheBlockSaysToUseTheCollisionGeometry) {
 <contact name="sole" link="foot" shape="box" size="0.2 0.1 0.02" support="floor"/>
 </appell></robot>)";
   EXPECT_EQ(test::loadMessage(xml, "r.urdf"),
-            "r.urdf:4: <contact name=\"sole\">: shape 'box' is not declared in the <appell> block: a box "
+            "r.urdf:4: <contact name=\"sole\">: shape 'box' is not declared in the <appell> block (a box "
+            "cannot roll: its faces and edges give no unique smooth contact point): a box "
             "touches with its vertices, taken from the collision geometry of the link — give the link "
             "<collision><geometry><box …/></geometry></collision> and write shape=\"collision\" "
             "(collision=\"NAME\" picks one of several)");

@@ -265,6 +265,10 @@ class Simulator {
   bool decideContactModes(std::string& error);
   StepStatus timeSteppingStep(double h);
   void openWindow(int constraint, std::string why);
+  /// The time-stepping stage, built on first use (false: no unilateral
+  /// constraint, or too large to allocate).
+  bool timeSteppingStage();
+  static constexpr double kEagerTimeSteppingDoubles = 1e7;  ///< 80 MB: built at construction
   bool closeWindow();
   void watchEvents(const StepStatus& st);
   int namedContact(const std::string& message) const;

@@ -45,9 +45,12 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   result_.reaction = VecX::Zero(model_.nv);
   setUpUnilateral();  // after q_, v_: its workspace copies their sizes
   timestepping::checkOptions(options_.timestepping);
-  if (uni_)
-    mj_ = std::make_unique<timestepping::MoreauJean>(model_, constraints_, options_.timestepping,
-                                                     options_.contacts.gap_tol);
+  // The time-stepping stage's workspace is dense over the unilateral rows
+  // (Delassus columns nv × rows): built here when that is modest, else when
+  // a first window needs it (timeSteppingStage) — a chain of 10⁵ joint
+  // limits must not reserve 10⁵ × 10⁵ doubles it never uses.
+  if (uni_ && static_cast<double>(model_.nv) * cdata_->m <= kEagerTimeSteppingDoubles)
+    timeSteppingStage();
   last_modes_.assign(constraints_.size(), 0);
   event_ring_.assign(options_.timestepping.zeno_events, 0.0);
   step_ring_.assign(options_.timestepping.collapse_steps, 0.0);
@@ -89,10 +92,10 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
     // Modes the events cannot decide: time-stepping decides them (auto), or
     // is the scheme anyway.
     event_count_ = step_count_ = 0;
-    stepping_ = mj_ && options_.scheme == ContactScheme::TimeStepping;
+    stepping_ = options_.scheme == ContactScheme::TimeStepping && timeSteppingStage();
     window_closed_once_ = false;
     window_min_ = options_.timestepping.min_window;
-    if (mj_ && !state_error_.empty() && options_.scheme != ContactScheme::Events) {
+    if (!state_error_.empty() && options_.scheme != ContactScheme::Events && timeSteppingStage()) {
       if (options_.scheme == ContactScheme::Auto) openWindow(namedContact(state_error_), state_error_);
       state_error_.clear();
     }
@@ -235,8 +238,8 @@ StepStatus Simulator::step(double h) {
     ++counters_.overconstrained;
     st = attemptStep(h);
   }
-  if (mj_ && options_.scheme == ContactScheme::Auto && options_.contacts.enabled) {
-    if (!st.ok) {
+  if (uni_ && options_.scheme == ContactScheme::Auto && options_.contacts.enabled) {
+    if (!st.ok && timeSteppingStage()) {
       // The events gave up here (no consistent mode, a step below h_min, a
       // solve that failed): fail() restored the step's start, from which a
       // time-stepping window takes the step.

@@ -23,6 +23,8 @@
 #include "simulator/simulator_internal.hpp"
 #include "timestepping/moreau_jean.hpp"
 
+#include <new>
+
 #include <cmath>
 #include <stdexcept>
 
@@ -70,8 +72,20 @@ void timestepping::checkOptions(const TimeSteppingOptions& o) {
         "stable_steps ≥ 1 are required");
 }
 
+bool Simulator::timeSteppingStage() {
+  if (mj_ || !uni_) return mj_ != nullptr;
+  try {
+    mj_ = std::make_unique<timestepping::MoreauJean>(model_, constraints_, options_.timestepping,
+                                                     options_.contacts.gap_tol);
+  } catch (const std::bad_alloc&) {
+    return false;  // too large to time-step: the events keep the scene (and report their failure)
+  }
+  return true;
+}
+
 bool Simulator::openTimeSteppingWindow(const std::string& why) {
-  if (!mj_ || options_.scheme != ContactScheme::Auto || stepping_ || !options_.contacts.enabled)
+  if (options_.scheme != ContactScheme::Auto || stepping_ || !options_.contacts.enabled ||
+      !timeSteppingStage())
     return false;
   openWindow(namedContact(why), why);
   return true;
@@ -151,7 +165,7 @@ void Simulator::watchEvents(const StepStatus& st) {
           << " s of simulated time (Zeno or slip-stick chattering; last: '"
           << constraints_[events_.back().constraint]->name() << "' "
           << toString(events_.back().kind) << ")";
-      openWindow(events_.back().constraint, why.str());
+      if (timeSteppingStage()) openWindow(events_.back().constraint, why.str());
       return;
     }
   }
@@ -165,7 +179,7 @@ void Simulator::watchEvents(const StepStatus& st) {
       std::ostringstream why;
       why << "the step size collapsed: " << o.collapse_steps << " steps advanced " << t_ - oldest
           << " s (the last " << st.h_taken << " s)";
-      openWindow(namedContact(""), why.str());
+      if (timeSteppingStage()) openWindow(namedContact(""), why.str());
     }
   }
 }

@@ -170,7 +170,8 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
   // A box, a solid cylinder or a mesh has no smooth contact point: it touches
   // with its vertices, and those come from the link's <collision> geometry.
   if (type && !type->make && type->role == ShapeRole::CollisionOnly)
-    fail(src, e, "shape '" + name + "' is not declared in the <appell> block: a " + name +
+    fail(src, e, "shape '" + name + "' is not declared in the <appell> block (" + type->cannot_roll +
+                     "): a " + name +
                      " touches with its vertices, taken from the collision geometry of the link — give the link "
                      "<collision><geometry><" + name + " …/></geometry></collision> and write shape=\"" +
                      kSoleShape + "\" (collision=\"NAME\" picks one of several)");
