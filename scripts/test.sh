@@ -7,8 +7,8 @@
 #                             (scripts/sanitize.sh). The benchmarks are not built
 #                             here: scripts/bench.sh builds and runs them.
 #   scripts/test.sh --quick   the fast local loop: the C++ tests only, in their own
-#                             build (build-quick: -O1, no Python, examples, viewer
-#                             or sanitizers); SANITIZE=0 keeps the Release suite
+#                             build (build-quick: -O1, no Python, viewer or
+#                             sanitizers); SANITIZE=0 keeps the Release suite
 #                             and skips only the sanitized part.
 # Extra arguments go to ctest (e.g. -R Friction). Times on 2 cores: README.md.
 set -euo pipefail
@@ -18,7 +18,7 @@ if [ "${1:-}" = "--quick" ]; then
   bash scripts/install-deps.sh
   cmake -S . -B build-quick -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" -DAPPELL_BUILD_BENCHMARKS=OFF \
-    -DAPPELL_BUILD_PYTHON=OFF -DAPPELL_BUILD_EXAMPLES=OFF >/dev/null
+    -DAPPELL_BUILD_PYTHON=OFF >/dev/null
   cmake --build build-quick -j"$(nproc)"
   exec ctest --test-dir build-quick --output-on-failure -j"$(nproc)" \
     -E '^(package_consumer|viewer_screenshot)$' "$@"
