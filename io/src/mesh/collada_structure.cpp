@@ -15,6 +15,7 @@
 // their <instance_node url="#id">s. The graph is then walked with an explicit
 // stack (no recursion of our own).
 #include "mesh/mesh_gate.hpp"
+#include "urdf/xml_util.hpp"
 
 #include <appell/urdf.hpp>
 
@@ -48,21 +49,6 @@ std::string attribute(const std::string& text, std::size_t begin, std::size_t en
   return "";
 }
 
-// The end of the start tag at `i` (the '>' outside quoted values), or npos.
-std::size_t tagEnd(const std::string& text, std::size_t i) {
-  char quote = 0;
-  for (std::size_t j = i + 1; j < text.size(); ++j) {
-    const char c = text[j];
-    if (quote) {
-      if (c == quote) quote = 0;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '>') {
-      return j;
-    }
-  }
-  return std::string::npos;
-}
 
 std::string elementName(const std::string& text, std::size_t i, std::size_t end) {
   std::size_t k = i + 1;

@@ -51,21 +51,6 @@ bool startsWith(const std::string& xml, std::size_t i, const char* prefix, bool 
   return true;
 }
 
-// The end of an element's start tag (the '>' outside quoted values), or npos.
-std::size_t elementTagEnd(const std::string& xml, std::size_t i) {
-  char quote = 0;
-  for (std::size_t j = i + 1; j < xml.size(); ++j) {
-    const char c = xml[j];
-    if (quote) {
-      if (c == quote) quote = 0;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '>') {
-      return j;
-    }
-  }
-  return std::string::npos;
-}
 
 [[noreturn]] void junkNode(const XmlSource& src, const std::string& xml, std::size_t i,
                            const char* why = "is not an element, an end tag, a comment or a declaration") {
@@ -94,7 +79,7 @@ static int nestingDepth(const XmlSource& src, const std::string& xml, int limit)
       --depth;
     } else if (i + 1 < n && (std::isalpha(static_cast<unsigned char>(xml[i + 1])) || xml[i + 1] == '_' ||
                              static_cast<unsigned char>(xml[i + 1]) >= 127)) {
-      end = elementTagEnd(xml, i);
+      end = tagEnd(xml, i);
       if (end != std::string::npos && xml[end - 1] != '/') deepest = std::max(deepest, ++depth);
       if (deepest > limit) return deepest;
     } else {

@@ -169,4 +169,19 @@ SE3 origin(const XmlSource& src, const TiXmlElement* e) {
   return X;
 }
 
+std::size_t tagEnd(const std::string& text, std::size_t i) {
+  char quote = 0;
+  for (std::size_t j = i + 1; j < text.size(); ++j) {
+    const char c = text[j];
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      return j;
+    }
+  }
+  return std::string::npos;
+}
+
 }  // namespace appell::io

@@ -33,6 +33,9 @@ std::string located(const XmlSource& src, const TiXmlElement* e, const std::stri
 /// `value` as it goes into a message: at most `keep` characters, then how
 /// long it was (an attribute may hold megabytes).
 std::string clipped(const std::string& value, std::size_t keep = 64);
+/// The end of the start tag at `i`: the first '>' outside quoted values, or
+/// npos (the URDF pre-scan and the Collada structure check scan tags so).
+std::size_t tagEnd(const std::string& text, std::size_t i);
 std::optional<double> parseNumber(const std::string& text, bool* finite = nullptr);
 
 /// Attribute accessors. `what` names the attribute in messages.
