@@ -40,7 +40,9 @@ int info(int argc, char** argv) {
   }
   const Scene scene = loadFromArgs(args, false);
   const Model& m = scene.model;
-  std::cout << "scene " << scene.source << "\n"
+  std::cout << "scene " << scene.source << "\n";
+  if (scene.robot_source != scene.source) std::cout << "robot " << scene.robot_source << "\n";
+  std::cout
             << m.nbodies << " bodies, nq = " << m.nq << ", nv = " << m.nv
             << ", total mass " << m.totalMass() << " kg, gravity " << m.gravity.transpose() << "\n\n";
   // Columns as wide as the longest name (CAD exports have long ones).

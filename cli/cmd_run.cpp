@@ -230,6 +230,7 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
   const SimulatorCounters& c = r.counters;
   const bool adaptive = adaptiveIntegrator(o.integrator);
   out << std::setprecision(6) << "scene        " << scene.source << "\n";
+  if (scene.robot_source != scene.source) out << "robot        " << scene.robot_source << "\n";
   for (const std::string& line : overrides) out << "override     " << line << "\n";
   out
       << "model        " << scene.model.nbodies << " bodies, nv = " << scene.model.nv << ", "

@@ -31,6 +31,7 @@ void refuseOverwritingInputs(const std::string& option, const std::string& out, 
                              const std::vector<std::string>& other_inputs) {
   std::vector<std::string> inputs = other_inputs;
   inputs.push_back(scene.source);
+  inputs.push_back(scene.robot_source);
   for (const LinkGeometry& link : scene.geometry)
     for (const auto* list : {&link.visual, &link.collision})
       for (const Geometry& g : *list)

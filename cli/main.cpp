@@ -20,6 +20,10 @@ commands:
   view         a self-contained HTML page replaying a run in 3-D (three.js)
   plot         PNG plots of a run's CSV: energy, residuals, contact loads, path
 
+SCENE.urdf is a URDF with an <appell> block, or a scene file: a top-level
+<appell robot="package://PKG/robot.urdf"> that adds contacts, the initial state
+and settings to a description left as published (docs/scene-format.md §3).
+
 'appell <command> --help' describes each command's options; 'appell --version' prints the version.
 )";
 

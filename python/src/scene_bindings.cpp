@@ -146,6 +146,9 @@ void bindScene(py::module_& m) {
   py::class_<Scene, std::shared_ptr<Scene>> scene(
       m, "Scene", "A loaded scene: model, constraints (contacts, then joint limits), initial state.");
   scene.def_readonly("source", &Scene::source)
+      .def_readonly("robot_source", &Scene::robot_source,
+                    "The robot description: source itself for a URDF; for a scene file "
+                    "(<appell robot=...>), the URDF it names, resolved.")
       .def_readonly("warnings", &Scene::warnings,
                     "What the loader left out and why (a missing visual mesh): file:line: element: reason.")
       .def_property_readonly("nq", [](const Scene& s) { return s.model.nq; })
@@ -303,7 +306,8 @@ void bindScene(py::module_& m) {
         "project_initial_state"_a = false, "joint_limits"_a = true,
         "initial_state_tolerance"_a = 1e-8, "balance_inertia"_a = py::none(),
         "bound_inertia"_a = py::none(), "bound_mass"_a = py::none(),
-        "Loads a URDF with an <appell> block. Raises SceneError naming the file, line and reason.\n"
+        "Loads a URDF with an <appell> block, or a scene file (<appell robot=\"URI\">) around a\n"
+        "description left as published. Raises SceneError naming the file, line and reason.\n"
         "balance_inertia, bound_inertia (kg m^2), bound_mass (kg): inertia repairs as MuJoCo's\n"
         "compiler options; None leaves the scene's <simulation> attribute in force. Repaired\n"
         "bodies and inertias loaded with a defect are listed in Scene.warnings.");

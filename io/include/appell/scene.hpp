@@ -132,6 +132,9 @@ struct Scene {
   SimulationSettings settings;
   std::vector<LinkGeometry> geometry;  ///< one per body, index = body
   std::string source;              ///< the file the scene was loaded from
+  /// The robot description: `source` itself for a URDF; for a scene file (a
+  /// top-level <appell robot="…">), the URDF its `robot` names, resolved.
+  std::string robot_source;
   /// What the loader left out and why, "file:line: <element>: reason" (a
   /// visual mesh that is missing or unreadable); `appell` prints them.
   std::vector<std::string> warnings;

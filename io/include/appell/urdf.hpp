@@ -1,4 +1,5 @@
-// Loading robots and scenes from URDF (+ meshes, + the `<appell>` block).
+// Loading robots and scenes from URDF (+ meshes, + the `<appell>` block, in
+// the URDF or in a scene file around it).
 //
 // The URDF conventions kept here (docs/scene-format.md has the details):
 //  - Bodies are the URDF links in depth-first order from the root (parent
@@ -64,10 +65,15 @@ struct LoadOptions {
 };
 
 /// Model only (links, joints, inertias, limits, gravity from the `<appell>`
-/// block if present). Throws SceneError.
+/// block if present). `path` may be a scene file: the model of the
+/// description it names, under its gravity. Throws SceneError.
 Model loadUrdfModel(const std::string& path, const LoadOptions& options = {});
 
-/// The whole scene. Throws SceneError; never returns a partial scene.
+/// The whole scene, from a URDF (with its `<appell>` block, if any) or from a
+/// scene file: a top-level `<appell robot="URI">` naming a description it
+/// leaves as published (resolved as a mesh URI, relative paths from the
+/// scene file's folder; docs/scene-format.md §3). Throws SceneError; never
+/// returns a partial scene.
 Scene loadScene(const std::string& path, const LoadOptions& options = {});
 
 /// The same from a string; `base_dir` resolves relative mesh paths and

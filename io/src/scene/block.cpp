@@ -389,12 +389,13 @@ InertiaRepairs parseInertiaRepairs(const XmlSource& src, const TiXmlElement* e) 
 
 }  // namespace
 
-AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
+AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* block, bool scene_file,
                              const std::string& base_dir, const LoadOptions& options) {
   AppellBlock b;
-  b.element = robot->FirstChildElement("appell");
+  b.element = block;
   if (!b.element) return b;
-  allowOnly(src, b.element, {"format"});
+  if (scene_file) allowOnly(src, b.element, {"robot", "format"});
+  else allowOnly(src, b.element, {"format"});
   if (has(b.element, "format")) {
     const std::string f = text(src, b.element, "format");
     if (f != "1" && f != "2")
@@ -402,8 +403,6 @@ AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
                            "before the planar joint's axes changed) and format=\"2\" (the current one)");
     b.format = f == "1" ? 1 : 2;
   }
-  if (b.element->NextSiblingElement("appell")) fail(src, b.element->NextSiblingElement("appell"),
-                                                    "more than one <appell> block");
   std::set<std::string> supports, contacts;
   bool have_gravity = false, have_simulation = false;
   for (const TiXmlElement* e = b.element->FirstChildElement(); e; e = e->NextSiblingElement()) {

@@ -92,9 +92,18 @@ struct AppellBlock {
   std::set<std::string> collisionLinks() const;
 };
 
-/// Reads the <appell> child of <robot> (if any). Throws SceneError.
-AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* robot,
+/// Reads an <appell> element (null: an empty block): the block embedded in a
+/// URDF, or the root of a scene file (`scene_file`: it also carries `robot`,
+/// read by loadSceneFromString). `base_dir` resolves the block's own files
+/// (terrain meshes). Throws SceneError.
+AppellBlock parseAppellBlock(const XmlSource& src, const TiXmlElement* block, bool scene_file,
                              const std::string& base_dir, const LoadOptions& options);
+
+/// Throws "unknown KIND 'NAME'" at `e`, saying which description was
+/// searched when the block is a scene file's, and the closest of `names`
+/// when it is a likely typo (unknown_name.cpp).
+[[noreturn]] void failUnknownName(const XmlSource& src, const TiXmlElement* e, const std::string& kind,
+                                  const std::string& name, const std::vector<std::string>& names);
 
 /// Reads the scene in the format its block declares (format.cpp): format 1's
 /// planar in-plane coordinates turned into the current axes; without a

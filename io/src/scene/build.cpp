@@ -167,7 +167,7 @@ Shape contactShape(const XmlSource& src, const ContactDecl& c, const LinkGeometr
 void setJointState(const XmlSource& src, const Model& model, const JointStateDecl& d, VecX& q,
                    VecX& v) {
   const int j = model.jointIndex(d.joint);
-  if (j < 0) fail(src, d.element, "unknown joint '" + d.joint + "'");
+  if (j < 0) failUnknownName(src, d.element, "joint", d.joint, model.joint_names);
   const Joint& joint = model.joints[j];
   auto qs = q.segment(joint.idx_q, joint.nq);
   if (d.position) {
@@ -252,7 +252,7 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
   for (const ContactDecl& c : block.contacts) {
     ContactSpec spec = c.spec;
     spec.body = model.bodyIndex(c.link);
-    if (spec.body < 0) fail(src, c.element, "unknown link '" + c.link + "'");
+    if (spec.body < 0) failUnknownName(src, c.element, "link", c.link, model.body_names);
     for (const Support& s : scene.supports)
       if (s.name == c.support) spec.support = s;
     ContactOrigin origin;
@@ -271,7 +271,7 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
         std::string reduced;
         made = makeVertexContacts(spec, c.rim_points > 0 ? c.rim_points : 16, &reduced);
         if (!reduced.empty())
-          scene.warnings.push_back(src.file + ":" + std::to_string(c.element->Row()) + ": " + reduced);
+          scene.warnings.push_back(where(src, c.element) + ": " + reduced);
       }
     } catch (const std::invalid_argument& e) {
       fail(src, c.element, std::string(e.what()) + " (shape: " + shapeName(spec.shape) + " from " +
@@ -330,7 +330,7 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
   scene.tau = VecX::Zero(model.nv);
   for (const EffortDecl& e : block.efforts) {
     const int j = model.jointIndex(e.joint);
-    if (j < 0) fail(src, e.element, "unknown joint '" + e.joint + "'");
+    if (j < 0) failUnknownName(src, e.element, "joint", e.joint, model.joint_names);
     const Joint& joint = model.joints[j];
     if (static_cast<int>(e.value.size()) != joint.nv)
       fail(src, e.element, std::string("'value' needs ") + std::to_string(joint.nv) +
@@ -341,7 +341,7 @@ void buildSceneContents(const XmlSource& src, const UrdfRobot& urdf, const Appel
   for (const ActuatorDecl& d : block.actuators) {
     Actuator a = d.actuator;
     a.joint = model.jointIndex(d.joint);
-    if (a.joint < 0) fail(src, d.element, "unknown joint '" + d.joint + "'");
+    if (a.joint < 0) failUnknownName(src, d.element, "joint", d.joint, model.joint_names);
     // The URDF's <limit effort> bounds the servo unless it names its own.
     if (!d.own_limit && std::isfinite(model.joints[a.joint].limits.effort) &&
         model.joints[a.joint].limits.effort > 0)

@@ -51,18 +51,17 @@ std::string folderOf(const std::string& path) {
 }  // namespace io
 
 Model loadUrdfModel(const std::string& path, const LoadOptions& options) {
-  const std::string xml = io::readFile(path);
-  const io::XmlSource src{path};
-  TiXmlDocument doc;
-  const TiXmlElement* robot = io::parseDocument(src, doc, xml);
-  const io::UrdfRobot urdf = io::readUrdf(src, robot);
+  io::Documents d;  // a URDF, or a scene file and its description
+  io::openDocuments(d, io::readFile(path), io::folderOf(path), path, options);
+  const io::UrdfRobot urdf = io::fromDescription(d, [&] { return io::readUrdf(d.src, d.robot); });
   // Only the gravity of the scene block matters for the model (the inertia
   // repairs are LoadOptions' alone here).
   Vec3 gravity(0, 0, -9.81);
-  if (const TiXmlElement* block = robot->FirstChildElement("appell"))
-    if (const TiXmlElement* g = block->FirstChildElement("gravity")) gravity = io::vec3(src, g, "xyz");
-  return io::buildRobot(src, urdf, io::folderOf(path), options, gravity, io::inertiaRepairs(options, {}))
-      .model;
+  if (d.block)
+    if (const TiXmlElement* g = d.block->FirstChildElement("gravity")) gravity = io::vec3(d.src, g, "xyz");
+  return io::fromDescription(d, [&] {
+    return io::buildRobot(d.src, urdf, d.robot_dir, options, gravity, io::inertiaRepairs(options, {})).model;
+  });
 }
 
 }  // namespace appell

@@ -127,8 +127,10 @@ std::string findPackage(const std::string& name, const LoadOptions& options) {
   return "";
 }
 
-std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
-                            const LoadOptions& options) {
+namespace io {
+
+std::string resolveFile(const std::string& what, const std::string& uri, const std::string& base_dir,
+                        const LoadOptions& options) {
   std::error_code ec;
   fs::path path;
   const std::string pkg = "package://", file = "file://";
@@ -140,15 +142,15 @@ std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
     const std::string rest = uri.substr(start);
     const auto slash = rest.find('/');
     const std::string name = rest.substr(0, slash);
-    if (name.empty()) throw SceneError("mesh '" + uri + "': no package name (write package://NAME/path/in/package, "
-                                          "or a path relative to the URDF's folder)");
+    if (name.empty()) throw SceneError(what + " '" + uri + "': no package name (write package://NAME/path/in/package, "
+                                          "or a path relative to the file's folder)");
     const std::string dir = findPackage(name, options);
     if (dir.empty()) {
       std::string searched;
       for (const auto& e : searchPath(options)) searched += (searched.empty() ? "" : ":") + e;
       std::string prefixes;
       for (const auto& e : amentPrefixes(options)) prefixes += (prefixes.empty() ? "" : ":") + e;
-      throw SceneError("mesh '" + uri + "': package '" + name + "' not found in the search path [" +
+      throw SceneError(what + " '" + uri + "': package '" + name + "' not found in the search path [" +
                        searched + "]" +
                        (prefixes.empty() ? "" : " nor under the AMENT_PREFIX_PATH prefixes [" + prefixes + "]") +
                        " (give --package-path / LoadOptions::package_paths, or set ROS_PACKAGE_PATH or "
@@ -163,11 +165,9 @@ std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
   if (path.is_relative()) path = fs::path(base_dir.empty() ? "." : base_dir) / path;
   path = fs::absolute(path, ec).lexically_normal();
   if (!fs::is_regular_file(path, ec))
-    throw SceneError("mesh '" + uri + "': file not found: " + path.string());
+    throw SceneError(what + " '" + uri + "': file not found: " + path.string());
   return path.string();
 }
-
-namespace io {
 
 std::string packageUriNote(const std::string& uri) {
   const std::string three = "package:///";
@@ -179,5 +179,10 @@ std::string packageUriNote(const std::string& uri) {
 }
 
 }  // namespace io
+
+std::string resolveMeshPath(const std::string& uri, const std::string& base_dir,
+                            const LoadOptions& options) {
+  return io::resolveFile("mesh", uri, base_dir, options);
+}
 
 }  // namespace appell

@@ -120,8 +120,7 @@ void rejectXacro(const XmlSource& src, const TiXmlElement* robot) {
 
 }  // namespace
 
-const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
-                                  const std::string& xml) {
+const TiXmlElement* parseXml(const XmlSource& src, TiXmlDocument& doc, const std::string& xml) {
   constexpr int kMaxDepth = 256;  // a URDF is 3–4 levels deep
   if (nestingDepth(src, xml, kMaxDepth) > kMaxDepth)
     fail(src, "malformed XML: elements nested more than " + std::to_string(kMaxDepth) +
@@ -137,12 +136,10 @@ const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
       where += ":" + std::to_string(doc.ErrorRow()) + ":" + std::to_string(doc.ErrorCol());
     throw SceneError(where + ": malformed XML: " + doc.ErrorDesc());
   }
-  const TiXmlElement* robot = doc.RootElement();
-  if (!robot) fail(src, "malformed XML: no root element");
-  if (std::string(robot->Value()) != "robot")
-    fail(src, robot, "the root element must be <robot>");
-  rejectXacro(src, robot);
-  return robot;
+  const TiXmlElement* root = doc.RootElement();
+  if (!root) fail(src, "malformed XML: no root element");
+  rejectXacro(src, root);
+  return root;
 }
 
 namespace {

@@ -101,6 +101,11 @@ Robot buildRobot(const XmlSource& src, const UrdfRobot& urdf, const std::string&
 /// The repairs in force: each one LoadOptions sets, else the scene's.
 InertiaRepairs inertiaRepairs(const LoadOptions& options, const InertiaRepairs& scene);
 
+/// resolveMeshPath for any file a description or scene names: `what` ("mesh",
+/// "robot") starts every message.
+std::string resolveFile(const std::string& what, const std::string& uri, const std::string& base_dir,
+                        const LoadOptions& options);
+
 /// The warning a mesh URI earns when the loader tolerates its form:
 /// `package:///NAME/…` is read as `package://NAME/…`. Empty when none.
 std::string packageUriNote(const std::string& uri);
@@ -113,9 +118,49 @@ inline constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{256} << 20;
 /// Absolute folder of a file path.
 std::string folderOf(const std::string& path);
 
-/// Parses the document and returns its <robot> element; throws SceneError
-/// with the parser's line and column on malformed XML.
-const TiXmlElement* parseDocument(const XmlSource& src, TiXmlDocument& doc,
-                                  const std::string& xml);
+/// Parses the document and returns its root element, whatever its tag;
+/// throws SceneError with the parser's line and column on malformed XML, and
+/// on unexpanded xacro anywhere in it.
+const TiXmlElement* parseXml(const XmlSource& src, TiXmlDocument& doc, const std::string& xml);
+/// The documents one load reads (documents.cpp): a URDF, whose <robot> may
+/// hold an <appell> block, or a scene file — a top-level <appell robot="…">
+/// — and the description it names. Filled in place (the elements point into
+/// the documents).
+struct Documents {
+  TiXmlDocument scene_doc;       ///< the file given (the URDF itself, or the scene file)
+  TiXmlDocument robot_doc;       ///< the description a scene file names
+  XmlSource src;                 ///< names each element's own file
+  const TiXmlElement* robot = nullptr;  ///< the description's <robot>
+  const TiXmlElement* block = nullptr;  ///< the <appell> in force; null: none
+  bool scene_file = false;
+  std::string robot_path;        ///< the description's file (resolved for a scene file)
+  std::string robot_dir;         ///< resolves the description's meshes
+  std::string block_dir;         ///< resolves the block's files (terrains)
+  std::vector<std::string> warnings;  ///< a description's own block ignored
+  /// " (the robot description scene.xml:2 names)" for a scene file, else empty.
+  std::string named_by;
+};
+
+/// Runs `read`, a stage reading the description; for a scene file, an error
+/// it throws (naming the description's file and line) also says which scene
+/// file named the description.
+template <class Read>
+auto fromDescription(const Documents& d, Read&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const SceneError& e) {
+    if (d.named_by.empty()) throw;
+    throw SceneError(std::string(e.what()) + d.named_by);
+  }
+}
+
+/// Parses `xml` (read from `name`, in folder `base_dir`) and, for a scene
+/// file, the description its `robot` names (resolved as a mesh URI is, from
+/// the scene file's folder). A description with its own <appell> block gives
+/// way to the scene file's, with a warning. Throws SceneError: a root that is
+/// neither <robot> nor <appell>, a scene file without `robot`, a description
+/// not found (every folder searched), not a URDF, or itself a scene file.
+void openDocuments(Documents& d, const std::string& xml, const std::string& base_dir,
+                   const std::string& name, const LoadOptions& options);
 
 }  // namespace appell::io

@@ -55,10 +55,18 @@ std::string clipQuoted(const std::string& reason) {
 }
 }  // namespace
 
+const std::string& XmlSource::fileOf(const TiXmlElement* e) const {
+  return e && scene_document && e->GetDocument() == scene_document ? scene_file : file;
+}
+
+std::string where(const XmlSource& src, const TiXmlElement* e) {
+  std::string at = src.fileOf(e);
+  if (e && e->Row() > 0) at += ":" + std::to_string(e->Row());
+  return at;
+}
+
 std::string located(const XmlSource& src, const TiXmlElement* e, const std::string& reason) {
-  std::string where = src.file;
-  if (e && e->Row() > 0) where += ":" + std::to_string(e->Row());
-  return where + ": " + (e ? describe(e) + ": " : std::string()) + clipQuoted(reason);
+  return where(src, e) + ": " + (e ? describe(e) + ": " : std::string()) + clipQuoted(reason);
 }
 
 void fail(const XmlSource& src, const TiXmlElement* e, const std::string& reason) {

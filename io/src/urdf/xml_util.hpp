@@ -13,14 +13,24 @@
 
 namespace appell::io {
 
-/// Where an element came from, for messages.
+/// Where an element came from, for messages. A scene file (a top-level
+/// <appell robot="…">) and the description it names are two documents: the
+/// description's source also knows the scene file's document, so a message
+/// about an element names the file that element is in.
 struct XmlSource {
   std::string file;
+  const TiXmlDocument* scene_document = nullptr;  ///< the scene file's, when there is one
+  std::string scene_file;
+
+  /// The file holding `e` (`file` when `e` is null).
+  const std::string& fileOf(const TiXmlElement* e) const;
 };
 
 /// "<joint name=\"j1\">" — the tag with its name attribute, if any.
 std::string describe(const TiXmlElement* e);
 
+/// "file:line" of an element (its file only when the element is null or has no line).
+std::string where(const XmlSource& src, const TiXmlElement* e);
 /// "file:line: <element>: reason" — the form of every message (errors and warnings).
 std::string located(const XmlSource& src, const TiXmlElement* e, const std::string& reason);
 /// Throws SceneError "file:line: <element>: reason".
