@@ -278,7 +278,7 @@ TEST(SceneFile, TheQuadrupedDropsStopsDeadAndRestsOnItsFeet) {
   EXPECT_NEAR(last_load, kMass * kG, 1e-8 * kMass * kG);
 }
 
-// Every command that takes a scene takes a scene file; info shows both files.
+// Every command that takes a scene takes a scene file; info and run show both files.
 TEST(SceneFile, TheCommandLineTakesASceneFile) {
   const std::string env = "ROS_PACKAGE_PATH=" + kRos1 + " ";
   const test::CommandResult info = test::runCommand(env + APPELL_BINARY_DIR "/cli/appell info " + kDrop);
@@ -289,6 +289,14 @@ TEST(SceneFile, TheCommandLineTakesASceneFile) {
       test::runCommand(env + APPELL_BINARY_DIR "/cli/appell run " + kDrop + " --duration 0.2 --quiet");
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(contains(run.output, "robot        " + kQuadruped + "\n")) << run.output;
+  // equilibria and linearize load it as well (the drop's start is no
+  // equilibrium: linearize gives no verdict, exit 3).
+  const test::CommandResult eq = test::runCommand(env + APPELL_BINARY_DIR "/cli/appell equilibria " + kDrop);
+  EXPECT_EQ(eq.status, 0) << eq.output;
+  EXPECT_TRUE(contains(eq.output, "scene " + kDrop + ": ")) << eq.output;
+  const test::CommandResult lin = test::runCommand(env + APPELL_BINARY_DIR "/cli/appell linearize " + kDrop);
+  EXPECT_EQ(lin.status, 3) << lin.output;
+  EXPECT_TRUE(contains(lin.output, "scene " + kDrop + "\n")) << lin.output;
   const test::CommandResult missing =
       test::runCommand("ROS_PACKAGE_PATH=/nonexistent " APPELL_BINARY_DIR "/cli/appell info " + kDrop);
   EXPECT_EQ(missing.status, 1) << missing.output;
