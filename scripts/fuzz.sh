@@ -13,10 +13,14 @@
 # (test_fuzz_regressions loads each file there under every build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
 target=${FUZZ_TARGET:-fuzz_scene_loader}
-bash scripts/configure-asan.sh
-cmake --build build-asan -j"$(nproc)" --target "$target"
+# FUZZ_BUILT=1: the caller built the target already (scripts/sanitize.sh runs
+# both fuzzers at once, one per core, and two builds of one tree must not race).
+if [ "${FUZZ_BUILT:-0}" != 1 ]; then
+  bash scripts/install-deps.sh
+  bash scripts/configure-asan.sh
+  cmake --build build-asan -j"$(nproc)" --target "$target"
+fi
 corpus=build-asan/corpus/$target
 mkdir -p "$corpus" build-asan/findings
 if [ "$target" = fuzz_scene_loader ]; then

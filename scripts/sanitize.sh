@@ -34,7 +34,25 @@ ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E 'package_consume
 seconds=${FUZZ_SECONDS:-30}
 seed=${FUZZ_SEED:-1}
 if [ "$seconds" != 0 ]; then
-  bash scripts/fuzz.sh -max_total_time="$seconds" -seed="$seed"
-  # The mesh gate too: every format assimp recognises by content, under any name.
-  FUZZ_TARGET=fuzz_mesh_loader bash scripts/fuzz.sh -max_total_time="$seconds" -seed="$seed"
+  # The scene loader and the mesh gate (every format assimp recognises by
+  # content, under any name) at once, one per core: the 2×30 s take 30 s.
+  cmake --build build-asan -j"$(nproc)" --target fuzz_scene_loader fuzz_mesh_loader
+  FUZZ_BUILT=1 bash scripts/fuzz.sh -max_total_time="$seconds" -seed="$seed" \
+    > build-asan/fuzz_scene_loader.log 2>&1 &
+  scene=$!
+  FUZZ_BUILT=1 FUZZ_TARGET=fuzz_mesh_loader bash scripts/fuzz.sh -max_total_time="$seconds" \
+    -seed="$seed" > build-asan/fuzz_mesh_loader.log 2>&1 &
+  mesh=$!
+  status=0
+  wait "$scene" || status=1
+  wait "$mesh" || status=1
+  # libFuzzer's summary (and any finding's report) of each run.
+  for t in fuzz_scene_loader fuzz_mesh_loader; do
+    echo "== $t"; grep -E '^(Done|stat::|==|SUMMARY|INFO: Seed)|ERROR|Test unit written' "build-asan/$t.log" || true
+  done
+  if [ "$status" != 0 ]; then
+    echo "sanitize: a fuzz run failed; its whole output is in build-asan/fuzz_*.log" >&2
+    tail -n 40 build-asan/fuzz_scene_loader.log build-asan/fuzz_mesh_loader.log >&2
+    exit 1
+  fi
 fi
