@@ -36,16 +36,21 @@ bool shortOfEnd(const LoopSpec& spec, double t, double eps) {
 // The hooks after an accepted step; false: the loop ends (`end` says how).
 bool observeStep(StepObserver& o, Simulator& sim, const StepStatus& st, long steps,
                  const LoopSpec& spec, bool& row_taken, LoopEnd& end) {
-  end = LoopEnd::Observer;
-  if (!o.check(sim, st)) return false;
+  if (!o.check(sim, st)) {
+    end = LoopEnd::Observer;
+    return false;
+  }
   const bool at_events = !sim.events().empty();
   if (at_events) o.events(sim);
-  if (!o.accepted(sim, st)) return false;
+  if (!o.accepted(sim, st)) {
+    end = LoopEnd::Observer;
+    return false;
+  }
   row_taken = steps % spec.row_every == 0 || (spec.row_at_events && at_events);
   if (row_taken) o.row(sim);
   const bool stop = o.stopRequested();
   o.progress(sim);
-  end = LoopEnd::Stopped;
+  if (stop) end = LoopEnd::Stopped;
   return !stop;
 }
 
