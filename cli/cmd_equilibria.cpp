@@ -68,7 +68,7 @@ int equilibria(int argc, char** argv) {
         theta.segment<3>(joint.idx_v) = M_PI * (qb.conjugate() * up);
         break;
       }
-      default: continue;
+      case JointType::Fixed: case JointType::Prismatic: case JointType::Ball: continue;
     }
     retract(m, scene.q0, theta, q);
     guesses.push_back(q);

@@ -6,6 +6,7 @@
 #include <appell/simulator.hpp>
 
 #include "ball.hpp"
+#include "painleve_rod.hpp"
 #include "simulation_helpers.hpp"
 
 #include <Eigen/Geometry>
@@ -186,28 +187,7 @@ TEST(ContactFriction, BallOnAnInclineRollsBelowTheFrictionAngleAndSlidesAbove) {
 // names the contact and says so from μ = 1.34 up; at μ = 1.32 or 0.3, or
 // sliding the other way, the rod slides normally.
 TEST(ContactFriction, PainleveRodIsReportedWithTheContactNamed) {
-  const double l = 0.5, m = 1.0, theta = std::atan(2.0);
-  auto rod = [&](double mu, double slip) {
-    ModelBuilder b;
-    b.setGravity(Vec3(0, 0, -kG));
-    const int body = b.addBody("rod", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
-                               principalInertia(m, Vec3(1e-4, m * l * l / 3, m * l * l / 3)), "free");
-    BuiltScene s;
-    s.model = b.build();
-    const Support floor{Plane{Vec3::Zero(), Vec3::UnitZ()}, StaticMotion{}, "floor"};
-    ContactOptions opt;
-    opt.name = "tip";
-    s.constraints.push_back(makeContact(ContactKind::Rolling, body, PointShape{Vec3(-l, 0, 0)}, floor, opt));
-    ContactSpec spec = static_cast<const ShapeContact&>(*s.constraints[0]).spec();
-    spec.mu = mu;
-    s.constraints[0] = makeContact(spec);
-    // Body x along the rod, from the tip A (on the floor) up to the centre G.
-    const Mat3 R = Eigen::AngleAxisd(-theta, Vec3::UnitY()).toRotationMatrix();
-    s.q0 = neutralConfiguration(s.model);
-    setFloatingPose(s.q0, 0, l * R.col(0), R);
-    s.v0 = floatingVelocity(R, Vec3::Zero(), Vec3(slip, 0, 0));
-    return s;
-  };
+  auto rod = [](double mu, double slip) { return painleveRod({.mu = mu, .slip = slip}); };
   struct Case {
     double mu, slip;
     bool paradox;

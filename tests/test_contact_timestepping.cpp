@@ -11,6 +11,8 @@
 #include <appell/vertex_contacts.hpp>
 
 #include "ball.hpp"
+#include "corner_box.hpp"
+#include "painleve_rod.hpp"
 #include "scene.hpp"
 #include "simulation_helpers.hpp"
 
@@ -29,38 +31,12 @@ constexpr double kG = 9.81;
 const Vec3 kHalf(0.2, 0.1, 0.05);
 constexpr double kMass = 2.0;
 
-struct BoxScene {
-  Model model;
-  ConstraintList constraints;
-  VecX q0, v0;
-};
+using BoxScene = BuiltScene;
 
 // A uniform box resting flat on z = 0 (its lowest corners at `h`), its eight
 // corners point contacts of `kind` with friction μ (∞: none given).
 BoxScene box(double h, ContactKind kind, double mu, const Mat3& R = Mat3::Identity()) {
-  ModelBuilder b;
-  b.setGravity(Vec3(0, 0, -kG));
-  const Vec3 d = 2 * kHalf;
-  const Vec3 I = kMass / 12 * Vec3(d.y() * d.y() + d.z() * d.z(), d.x() * d.x() + d.z() * d.z(),
-                                   d.x() * d.x() + d.y() * d.y());
-  b.addBody("box", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
-            principalInertia(kMass, I), "free");
-  BoxScene s;
-  s.model = b.build();
-  ContactSpec spec;
-  spec.kind = kind;
-  spec.body = 0;
-  spec.shape = Box{kHalf, SE3::Identity()};
-  spec.support = Support{Plane{}, StaticMotion{}, "ground"};
-  spec.mu = mu;
-  spec.options.name = "box";
-  for (auto& c : makeVertexContacts(spec)) s.constraints.push_back(c);
-  double lowest = INFINITY;
-  for (const Vec3& v : contactVertices(spec.shape)) lowest = std::min(lowest, (R * v).z());
-  s.q0 = neutralConfiguration(s.model);
-  setFloatingPose(s.q0, 0, Vec3(0, 0, h - lowest), R);
-  s.v0 = VecX::Zero(s.model.nv);
-  return s;
+  return cornerBox({.half = kHalf, .mass = kMass, .h = h, .R = R, .kind = kind, .mu = mu});
 }
 
 SimulatorOptions scheme(ContactScheme c, double step = 1e-3) {
@@ -218,25 +194,7 @@ TEST(ContactTimeStepping, SlidingBallAutoTakesNoWindowAndStaysExact) {
 // and runs on: the impulse scheme resolves the paradox by a tangential
 // impact, the floor never pulls, and the rod does not sink.
 TEST(ContactTimeStepping, AutoOpensAWindowWhereTheEventsFindNoMode) {
-  const double l = 0.5, m = 1.0, theta = std::atan(2.0), mu = 2.0;
-  ModelBuilder b;
-  b.setGravity(Vec3(0, 0, -kG));
-  const int body = b.addBody("rod", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
-                             principalInertia(m, Vec3(1e-4, m * l * l / 3, m * l * l / 3)), "free");
-  BuiltScene s;
-  s.model = b.build();
-  ContactSpec spec;
-  spec.kind = ContactKind::Rolling;
-  spec.body = body;
-  spec.shape = PointShape{Vec3(-l, 0, 0)};
-  spec.support = Support{Plane{Vec3::Zero(), Vec3::UnitZ()}, StaticMotion{}, "floor"};
-  spec.mu = mu;
-  spec.options.name = "tip";
-  s.constraints.push_back(makeContact(spec));
-  const Mat3 R = Eigen::AngleAxisd(-theta, Vec3::UnitY()).toRotationMatrix();
-  s.q0 = neutralConfiguration(s.model);
-  setFloatingPose(s.q0, 0, l * R.col(0), R);
-  s.v0 = floatingVelocity(R, Vec3::Zero(), Vec3(-1.0, 0, 0));
+  const BuiltScene s = painleveRod({.mu = 2.0, .slip = -1.0});
   Simulator events(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
                    IntegratorType::DormandPrince54, appell::test::tightIntegrator(),
                    scheme(ContactScheme::Events));

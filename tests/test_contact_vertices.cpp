@@ -8,6 +8,7 @@
 #include <appell/urdf.hpp>
 #include <appell/vertex_contacts.hpp>
 
+#include "corner_box.hpp"
 #include "scene.hpp"
 #include "simulation_helpers.hpp"
 
@@ -28,37 +29,13 @@ constexpr double kG = 9.81;
 const Vec3 kHalf(0.2, 0.1, 0.05);
 constexpr double kMass = 2.0;
 
-struct DroppedBox {
-  Model model;
-  ConstraintList constraints;
-  VecX q0, v0;
-};
+using DroppedBox = BuiltScene;
 
 // A uniform box whose lowest corner starts `h` above the plane z = 0,
 // rotated by R, all corners declared as point contacts of `kind`.
 DroppedBox droppedBox(double h, const Mat3& R, ContactKind kind, double restitution = 0) {
-  ModelBuilder b;
-  const Vec3 d = 2 * kHalf;
-  const Vec3 I = kMass / 12 * Vec3(d.y() * d.y() + d.z() * d.z(), d.x() * d.x() + d.z() * d.z(),
-                                   d.x() * d.x() + d.y() * d.y());
-  b.addBody("box", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
-            principalInertia(kMass, I), "free");
-  DroppedBox s;
-  s.model = b.build();
-  ContactSpec spec;
-  spec.kind = kind;
-  spec.body = 0;
-  spec.shape = Box{kHalf, SE3::Identity()};
-  spec.support = Support{Plane{}, StaticMotion{}, "ground"};
-  spec.restitution = restitution;
-  spec.options.name = "box";
-  for (auto& c : makeVertexContacts(spec)) s.constraints.push_back(c);
-  double lowest = INFINITY;
-  for (const Vec3& v : contactVertices(spec.shape)) lowest = std::min(lowest, (R * v).z());
-  s.q0 = neutralConfiguration(s.model);
-  setFloatingPose(s.q0, 0, Vec3(0, 0, h - lowest), R);
-  s.v0 = VecX::Zero(s.model.nv);
-  return s;
+  return cornerBox(
+      {.half = kHalf, .mass = kMass, .h = h, .R = R, .kind = kind, .restitution = restitution});
 }
 
 double normalForceSum(const Simulator& sim) {

@@ -2,7 +2,9 @@
 // each have one table. These tests fail when a parser, an error message, the
 // scene format, the command-line help or the docs drift from their table.
 #include <appell/constrained_dynamics.hpp>
+#include <appell/configuration.hpp>
 #include <appell/integrators.hpp>
+#include <appell/joint_types.hpp>
 #include <appell/urdf.hpp>
 
 #include "test_contact_common.hpp"
@@ -240,4 +242,56 @@ TEST(NameTables, SceneFormatDocumentsEveryName) {
     for (const char* a : t.aliases) EXPECT_TRUE(documented(a)) << a;
     for (const char* p : t.parameters) EXPECT_TRUE(documented(p)) << t.name << "." << p;
   }
+}
+
+// The joint type table (joint_types.hpp; its order and sizes are checked by a
+// static_assert there): every entry names its type, and the model builder,
+// the configuration space and the coordinate names do what it says — sizes,
+// the quaternion's place (the neutral one is the identity, a zero one is
+// found), positions that are local coordinates (a unit θ in the slot the
+// table names moves exactly that position, and the position's name finds
+// that slot).
+TEST(NameTables, JointTypeTableDescribesEveryJointAsBuilt) {
+  for (const JointTypeInfo& t : kJointTypes) {
+    SCOPED_TRACE(t.name);
+    EXPECT_STREQ(toString(t.type), t.name);
+    EXPECT_EQ(findJointType(t.name), &t);
+    EXPECT_EQ(jointNq(t.type), t.nq);
+    EXPECT_EQ(jointNv(t.type), t.nv);
+    ModelBuilder b;
+    const Inertia box{1.0, Vec3::Zero(), Vec3(0.1, 0.2, 0.3).asDiagonal()};
+    b.addBody("base", -1, SE3::Identity(), JointType::Revolute, Vec3::UnitX(), box, "hinge");
+    b.addBody("link", 0, SE3::Identity(), t.type, Vec3::UnitZ(), box, "j");
+    const Model m = b.build();
+    ASSERT_EQ(m.nq, 1 + t.nq);
+    ASSERT_EQ(m.nv, 1 + t.nv);
+    const std::vector<std::string> q_names = coordinateNames(m, false), v_names = coordinateNames(m, true);
+    ASSERT_EQ(q_names.size(), static_cast<std::size_t>(m.nq));
+    ASSERT_EQ(v_names.size(), static_cast<std::size_t>(m.nv));
+    for (int k = 0; k < t.nv; ++k) EXPECT_EQ(localCoordinateIndex(m, v_names[1 + k]), 1 + k);
+    const VecX q0 = neutralConfiguration(m);
+    if (t.quaternion >= 0) {
+      EXPECT_EQ(q0.segment<4>(1 + t.quaternion), Eigen::Vector4d(0, 0, 0, 1));
+      VecX q = q0;
+      q.segment<4>(1 + t.quaternion).setZero();
+      EXPECT_EQ(degenerateQuaternionJoint(m, q), 1);
+    }
+    for (int k = 0; k < t.nq; ++k) {
+      const bool in_quaternion = t.quaternion >= 0 && k >= t.quaternion && k < t.quaternion + 4;
+      if (in_quaternion) {
+        EXPECT_THROW(localCoordinateIndex(m, q_names[1 + k]), std::invalid_argument) << q_names[1 + k];
+        continue;
+      }
+      ASSERT_GE(t.position_slot, 0);
+      const int slot = 1 + t.position_slot + k;
+      EXPECT_EQ(localCoordinateIndex(m, q_names[1 + k]), slot) << q_names[1 + k];
+      VecX theta = VecX::Zero(m.nv), q(m.nq);
+      theta[slot] = 0.25;
+      retract(m, q0, theta, q);
+      VecX moved = VecX::Zero(m.nq);
+      moved[1 + k] = 0.25;
+      EXPECT_EQ(q - q0, moved) << q_names[1 + k];
+    }
+  }
+  EXPECT_EQ(findJointType("hinge"), nullptr);
 }

@@ -7,25 +7,6 @@ namespace appell {
 
 namespace {
 
-std::vector<std::string> coordNames(JointType type, bool velocity) {
-  switch (type) {
-    case JointType::Fixed: return {};
-    case JointType::Revolute:
-    case JointType::Continuous:
-    case JointType::Prismatic: return {""};
-    case JointType::Planar:
-      return velocity ? std::vector<std::string>{".vx", ".vy", ".omega"}
-                      : std::vector<std::string>{".x", ".y", ".theta"};
-    case JointType::Floating:
-      return velocity ? std::vector<std::string>{".wx", ".wy", ".wz", ".vx", ".vy", ".vz"}
-                      : std::vector<std::string>{".x", ".y", ".z", ".qx", ".qy", ".qz", ".qw"};
-    case JointType::Ball:
-      return velocity ? std::vector<std::string>{".wx", ".wy", ".wz"}
-                      : std::vector<std::string>{".qx", ".qy", ".qz", ".qw"};
-  }
-  return {};
-}
-
 std::string csvField(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
   std::string q = "\"";
@@ -38,42 +19,10 @@ std::string csvField(const std::string& s) {
 
 }  // namespace
 
-std::vector<std::string> coordinateNames(const Model& model, bool velocities) {
-  std::vector<std::string> names;
-  for (int j = 0; j < model.nbodies; ++j)
-    for (const std::string& c : coordNames(model.joints[j].type, velocities))
-      names.push_back(model.joint_names[j] + c);
-  return names;
-}
-
-int localCoordinateIndex(const Model& model, const std::string& name) {
-  for (int j = 0; j < model.nbodies; ++j) {
-    const Joint& joint = model.joints[j];
-    const std::string& jn = model.joint_names[j];
-    if (name.compare(0, jn.size(), jn) != 0) continue;
-    const std::string coord = name.substr(jn.size());
-    const std::vector<std::string> vel = coordNames(joint.type, true), pos = coordNames(joint.type, false);
-    for (std::size_t k = 0; k < vel.size(); ++k)
-      if (coord == vel[k]) return joint.idx_v + static_cast<int>(k);
-    for (std::size_t k = 0; k < pos.size(); ++k) {
-      if (coord != pos[k]) continue;
-      if (pos[k].rfind(".q", 0) == 0)
-        throw std::invalid_argument("'" + name + "' is a quaternion component, not a coordinate of its own; name a "
-                                    "rotation slot (" + jn + ".wx, .wy, .wz: rotations about the body axes)");
-      // Floating: θ = (rotation, world translation), so .x .y .z are slots 3–5;
-      // planar and one-degree-of-freedom joints: position k is slot k.
-      return joint.idx_v + static_cast<int>(joint.type == JointType::Floating ? k + 3 : k);
-    }
-  }
-  return -1;
-}
-
 std::vector<std::string> trajectoryColumns(const Model& model, const ConstraintList& constraints) {
   std::vector<std::string> cols = {"time"};
   for (const char* prefix : {"q:", "v:"})
-    for (int j = 0; j < model.nbodies; ++j)
-      for (const std::string& c : coordNames(model.joints[j].type, prefix[0] == 'v'))
-        cols.push_back(prefix + model.joint_names[j] + c);
+    for (const std::string& c : coordinateNames(model, prefix[0] == 'v')) cols.push_back(prefix + c);
   cols.push_back("energy");
   cols.push_back("residual");
   for (const auto& con : constraints) {

@@ -34,7 +34,7 @@ EquilibriumOptions equilibriumOptions(const Scene& s, const std::optional<VecX>&
 }
 
 /// Cyclic coordinates by velocity index, or by name — a velocity's
-/// (Scene.velocity_names) or a position's (localCoordinateIndex, output.hpp).
+/// (Scene.velocity_names) or a position's (localCoordinateIndex, joint_types.hpp).
 std::vector<int> cyclicIndices(const Scene& s, const py::iterable& cyclic) {
   std::vector<int> out;
   for (py::handle c : cyclic) {

@@ -71,8 +71,9 @@ class Simulation {
   /// after which the work balance is off by more than max_energy_error of the
   /// energy that moved (DivergenceWatch) is undone and reported as failed.
   StepStatus step(std::optional<double> h);
-  /// Steps until t_end as Simulator::advanceTo does (fixed steps of h, or the
-  /// adaptive suggestion), collecting every step's events; when `record` is
+  /// Steps until t_end with the one loop (appell/run_loop.hpp, as
+  /// Simulator::advanceTo: fixed steps of h, or the adaptive suggestion
+  /// starting from h), collecting every step's events; when `record` is
   /// given, samples the start and every `every`-th step and the end.
   /// h absent: dt(); given, it must be finite and positive, and t_end finite.
   StepStatus advanceTo(double t_end, std::optional<double> h, Recording* record = nullptr,
@@ -100,9 +101,13 @@ class Simulation {
   };
 
  private:
+  class LoopObserver;
   void collectEvents();
   /// One step of the simulator, undone (and failed) if the watch says so.
   StepStatus watchedStep(double h);
+  /// After a step: when the divergence watch rejects its state, sets the
+  /// state back to (t, q, v) and says why.
+  bool watchRejects(double t, const VecX& q, const VecX& v, std::string& why);
 
   std::shared_ptr<const Scene> scene_;
   SimulationOptions options_;

@@ -1,5 +1,6 @@
 // The run loop and its summary (run.hpp).
 #include <appell/divergence_watch.hpp>
+#include <appell/run_loop.hpp>
 
 #include "contact_stats.hpp"
 #include "rank_margin.hpp"
@@ -117,11 +118,13 @@ std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& o
   check(options);
   IntegratorOptions iopt;
   iopt.rtol = options.tol;
-  iopt.atol = options.tol * 1e-2;
-  iopt.h_max = std::max(options.dt, options.duration / 20);
+  iopt.atol = options.atol.value_or(options.tol * 1e-2);
+  iopt.h_min = options.h_min;
+  iopt.h_max = options.h_max.value_or(std::max(options.dt, options.duration / 20));
   SimulatorOptions sopt;
   sopt.project_positions = options.project_positions;
   sopt.project_velocities = options.project_velocities;
+  sopt.contacts.enabled = options.contact_events;
   sopt.contacts.settle_time = options.settle_time;
   sopt.scheme = options.contacts;
   auto sim = std::make_unique<Simulator>(
@@ -133,17 +136,158 @@ std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& o
   return sim;
 }
 
-RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObserver& on_sample,
-                    const RunObserver& on_step) {
-  const std::unique_ptr<Simulator> owned = makeSimulator(scene, options);
-  Simulator& sim = *owned;
-  RunSummary s;
+namespace {
+
+// Each event of the simulator's last step, named, into the summary.
+void recordEvents(RunSummary& s, const Scene& scene, const Simulator& sim) {
+  for (const ContactEvent& ev : sim.events()) {
+    RunEvent r;
+    r.t = ev.t;
+    r.contact = scene.constraints[ev.constraint]->name();
+    r.kind = ev.kind;
+    r.speed_before = ev.speed_before;
+    r.speed_after = ev.speed_after;
+    r.normal_impulse = ev.normal_impulse;
+    r.tangential_impulse = ev.tangential_impulse;
+    r.outside_friction_cone =
+        ev.tangential_impulse > s.contacts[ev.constraint].mu * ev.normal_impulse * (1 + 1e-9);
+    const auto* c = dynamic_cast<const ShapeContact*>(scene.constraints[ev.constraint].get());
+    if (ev.kind == ContactEventKind::Feature && c)
+      if (const auto* mesh = std::get_if<TerrainMesh>(&c->spec().support.surface))
+        r.piece = terrainFeatureName(*mesh, ev.feature);
+    s.events.push_back(std::move(r));
+  }
+}
+
+// runScene's view of the loop (run_loop.hpp): the watches that stop a run
+// (divergence, drift, uncovered vertices, a stall), the events named, the
+// summary's maxima and per-contact statistics, the caller's observers.
+class SummaryObserver final : public StepObserver {
+ public:
+  SummaryObserver(const Scene& scene, const RunOptions& options, RunSummary& s,
+                  const Simulator& sim, DivergenceWatch& energy,
+                  run_detail::RankMarginWatch& margins, const RunObserver& on_sample,
+                  const RunObserver& on_step)
+      : scene_(scene), options_(options), s_(s), energy_(energy), margins_(margins),
+        on_sample_(on_sample), on_step_(on_step), t_good_(sim.time()), q_good_(sim.q()),
+        v_good_(sim.v()), vertices_(scene),
+        stall_(options.watchdog_fraction, options.watchdog_interval, sim.time(), s.events.size()) {}
+
+  bool check(Simulator& sim, const StepStatus&) override;
+  void events(const Simulator& sim) override { recordEvents(s_, scene_, sim); }
+  bool accepted(Simulator& sim, const StepStatus&) override;
+  void row(const Simulator& sim) override {
+    if (on_sample_) on_sample_(sim);
+  }
+  bool stopRequested() override {
+    if (!(options_.stop && options_.stop->load())) return false;
+    s_.interrupted = true;
+    return true;
+  }
+  void progress(const Simulator& sim) override {
+    if (on_step_) on_step_(sim);
+  }
+  /// The divergence watch went back to the last good state.
+  bool restored() const { return restored_; }
+
+ private:
+  const Scene& scene_;
+  const RunOptions& options_;
+  RunSummary& s_;
+  DivergenceWatch& energy_;
+  run_detail::RankMarginWatch& margins_;
+  const RunObserver& on_sample_;
+  const RunObserver& on_step_;
+  // The last state within the watches' bounds, to go back to (sized once).
+  double t_good_;
+  VecX q_good_, v_good_;
+  run_detail::VertexWatch vertices_;  // boxes and meshes on terrain meshes
+  run_detail::StallWatch stall_;
+  double deviation_ = 0;
+  bool restored_ = false;  // went back to the last good state (its loss counters restart)
+};
+
+
+// The watches that reject a step's state: the work balance (diverging), the
+// constraint residual (drift), vertices off the terrain. Rejected: the run
+// fails, set back to the last good state.
+bool SummaryObserver::check(Simulator& sim, const StepStatus&) {
+  const bool diverged = !energy_.check(sim);
+  deviation_ = energy_.deviation();
+  s_.energy_scale = energy_.scale();
+  std::string uncovered;
+  const double residual = std::max(sim.velocityResidual(), sim.gapResidual());
+  const bool drifted = std::isfinite(options_.max_residual) && !(residual <= options_.max_residual);
+  if (diverged || drifted || !vertices_.check(sim, uncovered)) {
+    std::ostringstream why;
+    if (drifted) {
+      why << "the constraint residual reached " << residual << " (|Av+b| "
+          << sim.velocityResidual() << ", |gap| " << sim.gapResidual() << ") at t = " << sim.time()
+          << " s, beyond the bound " << options_.max_residual
+          << (options_.project_positions ? ": the constraints are no longer held"
+                                         : ": the drift grows without projection — drop --no-projection");
+    } else if (diverged) {
+      // Diverging (an explicit method past its stability limit, a step too
+      // long for a stiff moment): stop before the numbers blow up.
+      why << (s_.passive ? "the energy error of this passive scene reached "
+                         : "the work balance of this driven scene (E + losses − work in − E0) is off by ")
+          << deviation_ << " J, " << energy_.relative()
+          << " of the energy that moved (kinetic, potential exchanged, work) at t = " << sim.time() << " s, beyond the bound "
+          << options_.max_energy_error
+          << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
+    } else {
+      why << "at t = " << sim.time() << " s: " << uncovered;
+    }
+    s_.ok = false;
+    s_.failure = why.str() + run_detail::stepStabilityCause(scene_, sim, options_);
+    s_.impact_energy_loss = sim.impactEnergyLoss();
+    s_.friction_work = sim.frictionWork();
+    s_.joint_work = sim.jointWork();
+    s_.support_work = sim.supportWork();
+    sim.setState(t_good_, q_good_, v_good_);  // (restarts the loss counters)
+    restored_ = true;
+    return false;
+  }
+  if (energy_.enabled() || std::isfinite(options_.max_residual) || vertices_.active()) {
+    t_good_ = sim.time();
+    q_good_ = sim.q();
+    v_good_ = sim.v();
+  }
+  return true;
+}
+
+// The step's bookkeeping: near-dependent rows, the stall watchdog (which may
+// open a time-stepping window or stop the run), the summary's maxima.
+bool SummaryObserver::accepted(Simulator& sim, const StepStatus&) {
+  margins_.sample(sim, !sim.events().empty(), s_.near_dependency);
+  if (stall_.stalled(sim.time(), s_.events.size())) {
+    s_.time = sim.time();
+    const std::string why = stall_.report(s_);
+    // The automatic scheme takes over with time-stepping; otherwise stop.
+    if (!sim.openTimeSteppingWindow(why)) {
+      s_.ok = false;
+      s_.failure = why;
+      return false;
+    }
+  }
+  s_.max_energy_deviation = std::max(s_.max_energy_deviation, deviation_);
+  s_.max_velocity_residual = std::max(s_.max_velocity_residual, sim.velocityResidual());
+  s_.max_gap_residual = std::max(s_.max_gap_residual, sim.gapResidual());
+  s_.max_redundant = std::max(s_.max_redundant, sim.redundantRows());
+  run_detail::sample(s_.contacts, sim.time(), sim.lambda(), sim.constraintData());
+  sampleActuators(s_, scene_, sim);
+  ++s_.samples;
+  return true;
+}
+
+// The summary at t = 0, before the first step.
+void startSummary(RunSummary& s, const Scene& scene, const RunOptions& options,
+                  const Simulator& sim, DivergenceWatch& energy_watch) {
   s.options = options;
   s.passive = passiveScene(scene);
   s.contacts = run_detail::contactStats(scene);
   run_detail::markHeldNormals(s.contacts, scene, sim);
   for (const Actuator& a : scene.actuators) s.actuators.push_back({a.name, 0, a.effort_limit, 0, -1, -1});
-  DivergenceWatch energy_watch(options.max_energy_error);
   energy_watch.start(sim);
   s.energy0 = energy_watch.energy0();
   s.energy_scale = energy_watch.scale();
@@ -156,6 +300,17 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
   sampleActuators(s, scene, sim);
   s.samples = 1;
+}
+
+}  // namespace
+
+RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObserver& on_sample,
+                    const RunObserver& on_step) {
+  const std::unique_ptr<Simulator> owned = makeSimulator(scene, options);
+  Simulator& sim = *owned;
+  RunSummary s;
+  DivergenceWatch energy_watch(options.max_energy_error);
+  startSummary(s, scene, options, sim, energy_watch);
   if (!sim.lastStateError().empty()) {
     s.ok = false;
     s.failure = sim.lastStateError() + forceMagnitudeCause(scene, sim);
@@ -164,132 +319,27 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
     if (on_sample) on_sample(sim);
     return s;
   }
-  auto record = [&](const Simulator& sm) {
-    for (const ContactEvent& ev : sm.events()) {
-      RunEvent r;
-      r.t = ev.t;
-      r.contact = scene.constraints[ev.constraint]->name();
-      r.kind = ev.kind;
-      r.speed_before = ev.speed_before;
-      r.speed_after = ev.speed_after;
-      r.normal_impulse = ev.normal_impulse;
-      r.tangential_impulse = ev.tangential_impulse;
-      r.outside_friction_cone =
-          ev.tangential_impulse > s.contacts[ev.constraint].mu * ev.normal_impulse * (1 + 1e-9);
-      const auto* c = dynamic_cast<const ShapeContact*>(scene.constraints[ev.constraint].get());
-      if (ev.kind == ContactEventKind::Feature && c)
-        if (const auto* mesh = std::get_if<TerrainMesh>(&c->spec().support.surface))
-          r.piece = terrainFeatureName(*mesh, ev.feature);
-      s.events.push_back(std::move(r));
-    }
-  };
-  record(sim);
+  recordEvents(s, scene, sim);  // the modes decided at t = 0
   run_detail::RankMarginWatch margins(scene, options);  // rows independent only by a margin
   margins.sample(sim, true, s.near_dependency);
-  if (on_sample) on_sample(sim);
+  SummaryObserver observer(scene, options, s, sim, energy_watch, margins, on_sample, on_step);
 
+  LoopSpec spec;
+  spec.t_end = options.duration;
+  spec.h = options.dt;
+  spec.finish = LoopSpec::Finish::Clip;
+  spec.row_every = options.output_every;
+  spec.row_at_events = true;  // a step that ends at an event is always a row
   const auto wall0 = std::chrono::steady_clock::now();
-  const bool adaptive = adaptiveIntegrator(options.integrator);
-  double h = options.dt;
-  long step = 0;
-  bool last_sampled = true;
-  // The last state within the divergence bound, to go back to (sized once).
-  double t_good = sim.time();
-  VecX q_good = sim.q(), v_good = sim.v();
-  const bool watch = energy_watch.enabled();
-  const bool watch_residual = std::isfinite(options.max_residual);
-  run_detail::VertexWatch vertices(scene);  // boxes and meshes on terrain meshes
-  bool restored = false;  // went back to the last good state (its loss counters restart)
-  run_detail::StallWatch stall(options.watchdog_fraction, options.watchdog_interval, sim.time(),
-                               s.events.size());
-  while (sim.time() < options.duration * (1 - 1e-12)) {
-    const StepStatus status = sim.step(std::min(h, options.duration - sim.time()));
-    if (!status.ok) {
-      s.ok = false;
-      s.failure = status.message + forceMagnitudeCause(scene, sim) +
-                  run_detail::stepStabilityCause(scene, sim, options);
-      break;
-    }
-    const bool diverged = !energy_watch.check(sim);
-    const double deviation = energy_watch.deviation();
-    s.energy_scale = energy_watch.scale();
-    std::string uncovered;
-    const double residual = std::max(sim.velocityResidual(), sim.gapResidual());
-    const bool drifted = watch_residual && !(residual <= options.max_residual);
-    if (diverged || drifted || !vertices.check(sim, uncovered)) {
-      std::ostringstream why;
-      if (drifted) {
-        why << "the constraint residual reached " << residual << " (|Av+b| "
-            << sim.velocityResidual() << ", |gap| " << sim.gapResidual() << ") at t = " << sim.time()
-            << " s, beyond the bound " << options.max_residual
-            << (options.project_positions ? ": the constraints are no longer held"
-                                          : ": the drift grows without projection — drop --no-projection");
-      } else if (diverged) {
-        // Diverging (an explicit method past its stability limit, a step too
-        // long for a stiff moment): stop before the numbers blow up.
-        why << (s.passive ? "the energy error of this passive scene reached "
-                          : "the work balance of this driven scene (E + losses − work in − E0) is off by ")
-            << deviation << " J, " << energy_watch.relative()
-            << " of the energy that moved (kinetic, potential exchanged, work) at t = " << sim.time() << " s, beyond the bound "
-            << options.max_energy_error
-            << ": the integration is diverging — use a smaller step or tolerance, or dopri5";
-      } else {
-        why << "at t = " << sim.time() << " s: " << uncovered;
-      }
-      s.ok = false;
-      s.failure = why.str() + run_detail::stepStabilityCause(scene, sim, options);
-      const double impacts = sim.impactEnergyLoss(), friction = sim.frictionWork();
-      const double joint = sim.jointWork(), support = sim.supportWork();
-      sim.setState(t_good, q_good, v_good);  // (restarts the loss counters)
-      s.impact_energy_loss = impacts;
-      s.friction_work = friction;
-      s.joint_work = joint;
-      s.support_work = support;
-      restored = true;
-      break;
-    }
-    if (watch || watch_residual || vertices.active()) {
-      t_good = sim.time();
-      q_good = sim.q();
-      v_good = sim.v();
-    }
-    ++step;
-    if (adaptive) h = status.h_next;
-    record(sim);
-    margins.sample(sim, !sim.events().empty(), s.near_dependency);
-    if (stall.stalled(sim.time(), s.events.size())) {
-      s.time = sim.time();
-      const std::string why = stall.report(s);
-      // The automatic scheme takes over with time-stepping; otherwise stop.
-      if (!sim.openTimeSteppingWindow(why)) {
-        s.ok = false;
-        s.failure = why;
-        break;
-      }
-    }
-    s.max_energy_deviation = std::max(s.max_energy_deviation, deviation);
-    s.max_velocity_residual = std::max(s.max_velocity_residual, sim.velocityResidual());
-    s.max_gap_residual = std::max(s.max_gap_residual, sim.gapResidual());
-    s.max_redundant = std::max(s.max_redundant, sim.redundantRows());
-    run_detail::sample(s.contacts, sim.time(), sim.lambda(), sim.constraintData());
-    sampleActuators(s, scene, sim);
-    ++s.samples;
-    // A step that ends at an event is always a sample: each event is a row.
-    const bool sampled = step % options.output_every == 0 || !sim.events().empty();
-    if (on_sample && sampled) on_sample(sim);
-    last_sampled = sampled;
-    if (options.stop && options.stop->load()) {
-      s.interrupted = true;
-      if (on_step) on_step(sim);
-      break;
-    }
-    if (on_step) on_step(sim);
-  }
+  const LoopResult loop = runLoop(sim, spec, &observer);
   s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  // The last state reached is always sampled (the failure leaves the last good one).
-  if (on_sample && !last_sampled) on_sample(sim);
+  if (loop.end == LoopEnd::Failed) {
+    s.ok = false;
+    s.failure = loop.status.message + forceMagnitudeCause(scene, sim) +
+                run_detail::stepStabilityCause(scene, sim, options);
+  }
   s.time = sim.time();
-  if (!restored) {
+  if (!observer.restored()) {
     s.impact_energy_loss = sim.impactEnergyLoss();
     s.friction_work = sim.frictionWork();
     s.joint_work = sim.jointWork();

@@ -1,4 +1,11 @@
+// The configuration space joint by joint: the neutral and random
+// configurations, retraction q = q₀ ⊕ θ and its rate, integration, the
+// difference q₁ ⊖ q₀, q̇ from v, quaternion normalisation. What each joint
+// type does is a switch over JointType with no default (the compiler lists
+// them when a type is added); its facts (sizes, where its quaternion sits)
+// come from the joint type table (joint_types.hpp).
 #include <appell/configuration.hpp>
+#include <appell/joint_types.hpp>
 
 #include <cmath>
 #include <limits>
@@ -17,10 +24,8 @@ void setQuat(VecX& q, int i, const Quat& r) {
 
 VecX neutralConfiguration(const Model& model) {
   VecX q = VecX::Zero(model.nq);
-  for (const Joint& j : model.joints) {
-    if (j.type == JointType::Floating) q[j.idx_q + 6] = 1;
-    if (j.type == JointType::Ball) q[j.idx_q + 3] = 1;
-  }
+  for (const Joint& j : model.joints)
+    if (const int at = jointTypeInfo(j.type).quaternion; at >= 0) q[j.idx_q + at + 3] = 1;  // w
   return q;
 }
 
@@ -41,8 +46,10 @@ void retractJoint(const Joint& j, const VecX& q0, const VecX& theta, VecX& q) {
     case JointType::Ball:
       setQuat(q, j.idx_q, quatAt(q0, j.idx_q) * quatExp(theta.segment<3>(j.idx_v)));
       break;
-    default:
+    case JointType::Revolute: case JointType::Continuous: case JointType::Prismatic:
+    case JointType::Planar:
       q.segment(j.idx_q, j.nq) += theta.segment(j.idx_v, j.nv);
+      break;
   }
 }
 
@@ -70,8 +77,9 @@ void jointRate(const Joint& j, const VecX& q0, const VecX& theta, const VecX& v,
       theta_dot[iv + 2] = v[iv + 2];
       break;
     }
-    default:
+    case JointType::Revolute: case JointType::Continuous: case JointType::Prismatic:
       theta_dot[iv] = v[iv];
+      break;
   }
 }
 
@@ -105,18 +113,24 @@ void retractWithRate(const Model& model, const VecX& q0, const VecX& theta, cons
   for (const Joint& j : model.joints) {
     const int iv = j.idx_v;
     Vec3 w_dot;
-    if (j.type == JointType::Floating) {
-      const Quat r = quatAt(q0, j.idx_q + 3) * expWithRate(theta.segment<3>(iv), v.segment<3>(iv), w_dot);
-      q.segment<3>(j.idx_q) += theta.segment<3>(iv + 3);
-      setQuat(q, j.idx_q + 3, r);
-      theta_dot.segment<3>(iv) = w_dot;
-      theta_dot.segment<3>(iv + 3) = r * Vec3(v.segment<3>(iv + 3));
-    } else if (j.type == JointType::Ball) {
-      setQuat(q, j.idx_q, quatAt(q0, j.idx_q) * expWithRate(theta.segment<3>(iv), v.segment<3>(iv), w_dot));
-      theta_dot.segment<3>(iv) = w_dot;
-    } else {
-      retractJoint(j, q0, theta, q);
-      jointRate(j, q0, theta, v, theta_dot);
+    switch (j.type) {
+      case JointType::Floating: {
+        const Quat r = quatAt(q0, j.idx_q + 3) * expWithRate(theta.segment<3>(iv), v.segment<3>(iv), w_dot);
+        q.segment<3>(j.idx_q) += theta.segment<3>(iv + 3);
+        setQuat(q, j.idx_q + 3, r);
+        theta_dot.segment<3>(iv) = w_dot;
+        theta_dot.segment<3>(iv + 3) = r * Vec3(v.segment<3>(iv + 3));
+        break;
+      }
+      case JointType::Ball:
+        setQuat(q, j.idx_q, quatAt(q0, j.idx_q) * expWithRate(theta.segment<3>(iv), v.segment<3>(iv), w_dot));
+        theta_dot.segment<3>(iv) = w_dot;
+        break;
+      case JointType::Fixed: case JointType::Revolute: case JointType::Continuous:
+      case JointType::Prismatic: case JointType::Planar:
+        retractJoint(j, q0, theta, q);
+        jointRate(j, q0, theta, v, theta_dot);
+        break;
     }
   }
 }
@@ -165,7 +179,9 @@ void integrate(const Model& model, const VecX& q0, const VecX& v, double h, VecX
         q[iq + 2] += w;
         break;
       }
-      default: q.segment(iq, j.nq) += h * v.segment(iv, j.nv);
+      case JointType::Revolute: case JointType::Continuous: case JointType::Prismatic:
+        q.segment(iq, j.nq) += h * v.segment(iv, j.nv);
+        break;
     }
   }
 }
@@ -187,8 +203,10 @@ void difference(const Model& model, const VecX& q0, const VecX& q1, VecX& theta)
       case JointType::Ball:
         theta.segment<3>(iv) = quatLog(quatAt(q0, j.idx_q).conjugate() * quatAt(q1, j.idx_q));
         break;
-      default:
+      case JointType::Revolute: case JointType::Continuous: case JointType::Prismatic:
+      case JointType::Planar:
         theta.segment(iv, j.nv) = q1.segment(j.idx_q, j.nq) - q0.segment(j.idx_q, j.nq);
+        break;
     }
   }
 }
@@ -217,16 +235,16 @@ void configurationRate(const Model& model, const VecX& q, const VecX& v, VecX& q
         qdot[iq + 2] = v[iv + 2];
         break;
       }
-      default: qdot[iq] = v[iv];
+      case JointType::Revolute: case JointType::Continuous: case JointType::Prismatic:
+        qdot[iq] = v[iv];
+        break;
     }
   }
 }
 
 void normalizeQuaternions(const Model& model, VecX& q) {
-  for (const Joint& j : model.joints) {
-    int at = j.type == JointType::Floating ? j.idx_q + 3 : j.type == JointType::Ball ? j.idx_q : -1;
-    if (at >= 0) q.segment<4>(at).normalize();
-  }
+  for (const Joint& j : model.joints)
+    if (const int at = jointTypeInfo(j.type).quaternion; at >= 0) q.segment<4>(j.idx_q + at).normalize();
 }
 
 VecX randomConfiguration(const Model& model, std::mt19937& rng) {
@@ -258,8 +276,9 @@ VecX randomConfiguration(const Model& model, std::mt19937& rng) {
 int degenerateQuaternionJoint(const Model& model, const VecX& q) {
   for (int k = 0; k < static_cast<int>(model.joints.size()); ++k) {
     const Joint& j = model.joints[k];
-    const int at = j.type == JointType::Floating ? j.idx_q + 3 : j.type == JointType::Ball ? j.idx_q : -1;
-    if (at >= 0 && !(q.segment<4>(at).squaredNorm() >= std::numeric_limits<double>::min())) return k;
+    const int at = jointTypeInfo(j.type).quaternion;
+    if (at >= 0 && !(q.segment<4>(j.idx_q + at).squaredNorm() >= std::numeric_limits<double>::min()))
+      return k;
   }
   return -1;
 }

@@ -1,5 +1,6 @@
 // The kinematic tree's small queries, and ModelBuilder: the structure checked body by
 // body; the inertias judged and repaired per rigid group in inertia_check.cpp.
+#include <appell/joint_types.hpp>
 #include <appell/model.hpp>
 
 #include "model/inertia_check.hpp"
@@ -10,37 +11,12 @@
 
 namespace appell {
 
+// The joint type table's facts (a value outside the enum: "?", no coordinates).
 const char* toString(JointType type) {
-  switch (type) {
-    case JointType::Fixed: return "fixed";
-    case JointType::Revolute: return "revolute";
-    case JointType::Continuous: return "continuous";
-    case JointType::Prismatic: return "prismatic";
-    case JointType::Planar: return "planar";
-    case JointType::Floating: return "floating";
-    case JointType::Ball: return "ball";
-  }
-  return "?";
+  return jointTypeIndex(type) < kJointTypes.size() ? jointTypeInfo(type).name : "?";
 }
-
-int jointNq(JointType type) {
-  switch (type) {
-    case JointType::Fixed: return 0;
-    case JointType::Revolute: case JointType::Continuous: case JointType::Prismatic: return 1;
-    case JointType::Planar: return 3;
-    case JointType::Floating: return 7;
-    case JointType::Ball: return 4;
-  }
-  return 0;
-}
-
-int jointNv(JointType type) {
-  switch (type) {
-    case JointType::Floating: return 6;
-    case JointType::Ball: case JointType::Planar: return 3;
-    default: return jointNq(type);
-  }
-}
+int jointNq(JointType type) { return jointTypeIndex(type) < kJointTypes.size() ? jointTypeInfo(type).nq : 0; }
+int jointNv(JointType type) { return jointTypeIndex(type) < kJointTypes.size() ? jointTypeInfo(type).nv : 0; }
 
 int Model::bodyIndex(const std::string& name) const {
   for (int i = 0; i < nbodies; ++i)
@@ -122,8 +98,7 @@ Model ModelBuilder::build(std::vector<std::string>* notes) const {
     j.idx_q = m.nq;
     j.idx_v = m.nv;
     j.limits = e.limits;
-    if (e.type == JointType::Revolute || e.type == JointType::Continuous ||
-        e.type == JointType::Prismatic || e.type == JointType::Planar) {
+    if (jointTypeInfo(e.type).has_axis) {
       if (!finite(e.axis) || e.axis.norm() < 1e-12) fail(e.name, "joint axis is zero or not finite");
       j.axis = e.axis.normalized();
     }

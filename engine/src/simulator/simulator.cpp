@@ -1,5 +1,6 @@
 #include <appell/configuration.hpp>
 #include <appell/dynamics.hpp>
+#include <appell/run_loop.hpp>
 #include <appell/simulator.hpp>
 #include <appell/tree_solver.hpp>
 
@@ -339,26 +340,9 @@ StepStatus Simulator::attemptStep(double h) {
   return st;
 }
 
+// The loop is run_loop.cpp's, carrying this simulator's step suggestion.
 StepStatus Simulator::advanceTo(double t_end, double h) {
-  if (!(h > 0) || !std::isfinite(h) || !std::isfinite(t_end))
-    throw std::invalid_argument("Simulator::advanceTo: h must be positive and t_end finite");
-  StepStatus st;
-  const double eps = 1e-12 * std::max(1.0, std::abs(t_end));
-  const bool adaptive = integrator_->adaptive();
-  if (adaptive && h_suggest_ <= 0) h_suggest_ = h;
-  while (t_end - t_ > eps) {
-    const double remaining = t_end - t_;
-    const double want = adaptive ? h_suggest_ : h;
-    // Absorb a remainder below eps into the last step rather than leave it.
-    const bool last = want >= remaining - eps;
-    st = step(last ? remaining : want);
-    if (!st.ok) return st;
-    // Land exactly on t_end (t + (t_end − t) may differ from t_end by an ulp).
-    if (last && st.h_taken == remaining) t_ = t_end;
-    // A step shortened to land on t_end says nothing about the next one.
-    if (adaptive && (!last || st.h_taken < remaining)) h_suggest_ = st.h_next;
-  }
-  return st;
+  return detail::advanceCarrying(*this, t_end, h, h_suggest_, t_);
 }
 
 }  // namespace appell

@@ -27,6 +27,7 @@
 #pragma once
 
 #include <appell/constraint_set.hpp>
+#include <appell/joint_types.hpp>
 #include <appell/scene.hpp>
 
 #include <ostream>
@@ -44,19 +45,8 @@ struct ContactState {
 /// The column names described above.
 std::vector<std::string> trajectoryColumns(const Model& model, const ConstraintList& constraints);
 
-/// The names of the nq position coordinates (velocities = false) or of the nv
-/// velocities: "<joint>[.<coord>]" as the CSV's q: and v: columns name them.
-std::vector<std::string> coordinateNames(const Model& model, bool velocities);
-
-/// Index into the local coordinates θ (size nv: linearization, cyclic
-/// coordinates; configuration.hpp) of the coordinate called `name` — by its
-/// velocity's name ("root_joint.vx", "spin") or, where a position coordinate
-/// is itself a local coordinate, by the position's name: a floating joint's
-/// ".x .y .z" (θ's world-frame translation), a planar joint's ".x .y .theta",
-/// a one-degree-of-freedom joint's own name. −1 when nothing is called that.
-/// Throws std::invalid_argument for a quaternion component (".qx" …), which
-/// is not a coordinate of its own, naming the rotation slots to use instead.
-int localCoordinateIndex(const Model& model, const std::string& name);
+// coordinateNames() and localCoordinateIndex(), the column names' source,
+// are the engine's (joint_types.hpp: the joint type table's names).
 
 class TrajectoryWriter {
  public:

@@ -26,6 +26,8 @@
 //               its reason and the time of the last good state.
 // The observer sees the state at t = 0, after every `output_every`-th step
 // and at the end; it may write a trajectory (TrajectoryWriter overload).
+// The stepping itself is the engine's one loop (appell/run_loop.hpp) with
+// the summary as its observer (run/src/run.cpp's SummaryObserver).
 #pragma once
 
 #include <appell/constrained_dynamics.hpp>
@@ -38,6 +40,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,7 +49,16 @@ namespace appell {
 struct RunOptions {
   double duration = 1.0;           ///< simulated time (s)
   double dt = 1e-3;                ///< fixed step (euler, rk4), first step (dopri5)
-  double tol = 1e-8;               ///< dopri5: relative tolerance (absolute: tol/100)
+  double tol = 1e-8;               ///< dopri5: relative tolerance (absolute: atol)
+  std::optional<double> atol;      ///< adaptive: absolute tolerance (absent: tol/100)
+  double h_min = IntegratorOptions{}.h_min;  ///< adaptive: give up below this step (s)
+  /// Adaptive: the largest step (s). Absent: max(dt, duration/20), so that a
+  /// run of known duration takes at least 20 steps; a simulation stepped
+  /// without a duration (Python's Simulation) gives its own (its h_max
+  /// option). All three are checked with the integrator's options.
+  std::optional<double> h_max;
+  /// Unilateral contacts may open and close (ContactEventOptions::enabled).
+  bool contact_events = true;
   IntegratorType integrator = IntegratorType::RK4;
   Formulation formulation = Formulation::Tree;
   bool project_positions = true;   ///< Newton on the holonomic gaps after every step
@@ -226,8 +238,9 @@ struct RunSummary {
 using RunObserver = std::function<void(const Simulator&)>;
 
 /// A Simulator for the scene: its solver, integrator and projection from the
-/// options, its constant joint forces, its state set to (0, q0, v0). The scene
-/// must outlive it.
+/// options, its constant joint forces, its state set to (0, q0, v0) — the one
+/// setup of `appell run`, runScene and Python's Simulation. The scene must
+/// outlive it.
 std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& options);
 
 /// Runs the scene (see the top of this file). `on_sample` sees the sampled

@@ -1,3 +1,8 @@
+// Drift projection (projection.hpp): Newton on the holonomic gaps in the
+// mass metric, then the solver's impulse solve. It lives with the solvers
+// because its Newton steps are solves — the tree solver's O(n) one, or the
+// dense row basis (row_basis.hpp) — so engine/src/constraints needs nothing
+// from engine/src/solvers.
 #include <appell/configuration.hpp>
 #include <appell/dynamics.hpp>
 #include <appell/projection.hpp>
