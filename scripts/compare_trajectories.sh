@@ -10,9 +10,15 @@
 # scene (default 2), or "scene" for each scene's own duration. OUT_DIR keeps the CSVs, logs and exit codes;
 # give "-" for a CLI whose side is already there (run the base once, compare
 # many times). Exit status 1 when any scene differs.
+#
+# A run the stall watchdog stops (run/src/stall_watch.cpp: wall-clock time)
+# is not reproducible even with one CLI — examples/cad_car at its own 6 s
+# differs between two runs of the same binary after t ≈ 2 s; compare it
+# with a DURATION below its stall.
 set -u
-base=$1
-new=$2
+abs() { [ "$1" = - ] && echo - || echo "$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"; }
+base=$(abs "$1")
+new=$(abs "$2")
 duration=${3:-2}
 out=${4:-$(mktemp -d)}
 span=(--duration "$duration")
