@@ -111,7 +111,7 @@ struct ContactEventOptions {
 };
 
 namespace detail {
-struct UnilateralState;  // the simulator's per-contact workspace (contact_events.cpp)
+struct UnilateralState;  // the simulator's per-contact workspace (simulator_internal.hpp)
 }
 
 }  // namespace appell

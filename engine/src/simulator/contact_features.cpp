@@ -25,7 +25,7 @@
 // contact that now approaches its new piece takes an impact.
 #include <appell/simulator.hpp>
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/simulator_impl.hpp"
 
 namespace appell {
 
@@ -42,7 +42,7 @@ using detail::UnilateralRow;
 /// pieces and the watcher's: where the body reaches the watched piece (a
 /// ball sliding down one slope of a valley meets the other) that is the
 /// watcher's touchdown, not a jump of the closed point onto it.
-void Simulator::applyLatches() {
+void Simulator::Impl::applyLatches() {
   auto& rows = uni_->rows;
   for (UnilateralRow& r : rows) {
     if (r.joint) continue;
@@ -76,7 +76,7 @@ static bool switched(const UnilateralRow& r) {
 /// Searches every contact's nearest piece at (t_, q_, v_) into feature_free
 /// (the rows in cdata_ are then the searched ones) and restores the latches.
 /// Returns the first closed row that switched, or −1.
-int Simulator::searchFeatures() {
+int Simulator::Impl::searchFeatures() {
   auto& u = *uni_;
   for (const UnilateralRow& r : u.rows)
     if (!r.joint) cdata_->blocks[r.c].latched_feature = -1;
@@ -94,7 +94,7 @@ int Simulator::searchFeatures() {
 
 /// Whether the searched rows in cdata_ are every closed contact's latched
 /// ones (after searchFeatures): then they need no re-evaluation.
-bool Simulator::searchedRowsLatched() const {
+bool Simulator::Impl::searchedRowsLatched() const {
   for (const UnilateralRow& r : uni_->rows)
     if (!r.joint && cdata_->isActive(r.c) && r.feature != r.feature_free) return false;
   return true;
@@ -102,7 +102,7 @@ bool Simulator::searchedRowsLatched() const {
 
 /// After a step with no switch: the pieces searched at its end are the next
 /// step's starting ones; an open contact follows its nearest piece.
-void Simulator::acceptFeatures() {
+void Simulator::Impl::acceptFeatures() {
   for (UnilateralRow& r : uni_->rows) {
     if (r.joint) continue;
     r.feature_start = r.feature_free;
@@ -116,7 +116,7 @@ void Simulator::acceptFeatures() {
 /// in feature_ahead) — takes its new piece (a Feature event each); an open
 /// one follows its nearest piece; the pieces now are the next step's
 /// starting ones.
-void Simulator::switchFeatures(bool lookahead) {
+void Simulator::Impl::switchFeatures(bool lookahead) {
   auto& u = *uni_;
   searchFeatures();
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {

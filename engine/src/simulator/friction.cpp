@@ -19,7 +19,7 @@
 #include <appell/kinematics.hpp>
 #include <appell/simulator.hpp>
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/simulator_impl.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -50,7 +50,7 @@ void detail::slipDirection(const ConstraintData& cd, UnilateralRow& r, double fl
   else r.dir = r.dir_start;
 }
 
-bool Simulator::solveDynamics(double t, const VecX& q, const VecX& v, const VecX& tau,
+bool Simulator::Impl::solveDynamics(double t, const VecX& q, const VecX& v, const VecX& tau,
                               ConstrainedResult& out, SolveOutputs outputs) {
   auto* u = uni_.get();
   if (u) {

@@ -1,6 +1,6 @@
 // Coulomb's law on an impact's friction impulses: sliding impacts.
 //
-// The impact phase (contact_events.cpp) finds the contacts in the impact
+// The impact stage (impact.cpp) finds the contacts in the impact
 // and their normal impulses by principal pivoting, each contact sticking:
 // its friction rows in the velocity projection, so the post-impact slip is
 // zero whatever tangential impulse that takes. Coulomb's law bounds that
@@ -44,7 +44,7 @@
 #include <appell/kinematics.hpp>
 #include <appell/simulator.hpp>
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/simulator_impl.hpp"
 
 #include <cmath>
 
@@ -52,29 +52,13 @@ namespace appell {
 
 using detail::UnilateralRow;
 
-bool Simulator::frictionImpact(std::string& error, int& separating) {
+bool Simulator::Impl::frictionImpact(std::string& error, int& separating) {
   separating = -1;
   auto& u = *uni_;
-  const ContactEventOptions& o = options_.contacts;
   // Here v_ = v⁺ with every contact sticking, u.vplus = v⁻, u.impulse the
   // projection's multipliers (the push along a row is −impulse).
-  u.onset.clear();
   int F = 0;
-  bool needed = false;
-  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
-    UnilateralRow& r = u.rows[k];
-    if (!r.touching || !r.in_set || r.nf == 0) continue;
-    const auto& sr = cdata_->slide[r.c];
-    double pt = 0;
-    for (int i = 0; i < sr.n; ++i)
-      pt += std::pow(u.impulse[cdata_->offset[r.c] + sr.row[i]] / sr.scale[i], 2);
-    needed = needed || cdata_->isSliding(r.c) ||
-             std::sqrt(pt) > r.mu * std::max(0.0, r.impulse) * (1 + 1e-9);
-    r.first_force = F;
-    F += r.nf;
-    u.onset.push_back(k);
-  }
-  if (!needed) return true;
+  if (!frictionImpactCandidates(F)) return true;
   const int K = static_cast<int>(u.onset.size());
   u.vstick = v_;
   u.vminus = u.vplus;
@@ -83,40 +67,11 @@ bool Simulator::frictionImpact(std::string& error, int& separating) {
     cdata_->setSliding(u.rows[k].c, true);
     u.rows[k].released = true;
   }
-  auto restore = [&](bool keep_modes) {
-    for (int k : u.onset) {
-      u.rows[k].released = false;
-      if (!keep_modes) cdata_->setSliding(u.rows[k].c, u.was_sliding[k] != 0);
-    }
-  };
   auto& p = u.onset_problem;
-  // The responses at (t, q, v⁻): they depend on q only.
-  v_ = u.vminus;
-  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  frictionUnitForces(u.onset, &UnilateralRow::first_force, p);
-  tau_.setZero();
-  if (!frictionResponses(t_, q_, v_, tau_, u.onset, &UnilateralRow::first_force, F, p, true)) {
-    restore(false);
+  if (!frictionImpactMaps(F, error)) {
+    releaseOnset(false);
     v_ = u.vstick;
-    error = "impact with friction: " + p.res.error;
     return false;
-  }
-  // Newton's law on the normal rows alone: v⁰ (in u.vplus), Pₙ⁰ (in p.ln0).
-  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  shiftImpactTargets();
-  u.vplus = v_;
-  if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
-    restore(false);
-    v_ = u.vstick;
-    error = "impact with friction: the impulse solve failed: " + solver_->lastError();
-    return false;
-  }
-  for (int j = 0; j < K; ++j) p.ln0[j] = -u.impulse[u.rows[u.onset[j]].global];
-  // s⁰: the released rows' slips at v⁰.
-  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, u.vplus);
-  for (int j = 0; j < K; ++j) {
-    const UnilateralRow& r = u.rows[u.onset[j]];
-    p.a0.segment(r.first_force, r.nf) = cdata_->slide[r.c].slip.head(r.nf);
   }
   // Block Gauss–Seidel over the disks, the normal impulses updated: a
   // contact sticks inside its static disk, else slides on its kinetic one.
@@ -135,7 +90,7 @@ bool Simulator::frictionImpact(std::string& error, int& separating) {
   if (!settled) {
     // Keep the sticking impact (its cone excess is then reported).
     ++counters_.friction_onset_unsettled;
-    restore(false);
+    releaseOnset(false);
     v_ = u.vstick;
     forwardKinematics(model_, *data_, q_, v_);
     return true;
@@ -145,13 +100,96 @@ bool Simulator::frictionImpact(std::string& error, int& separating) {
   v_.noalias() += p.V.leftCols(F) * p.f.head(F);
   p.acc.head(F) = p.a0.head(F);
   p.acc.head(F).noalias() += p.W.topLeftCorner(F, F) * p.f.head(F);
+  if (!applyFrictionImpulses(F, separating, error)) return false;
+  releaseOnset(true);
+  forwardKinematics(model_, *data_, q_, v_);
+  return true;
+}
+
+/// The touching contacts in the impact's set with friction rows: u.onset,
+/// each one's first unknown, F their friction rows. Whether any needs
+/// Coulomb's law (one sliding, or sticking impulses outside its cone).
+bool Simulator::Impl::frictionImpactCandidates(int& F) {
+  auto& u = *uni_;
+  u.onset.clear();
+  F = 0;
+  bool needed = false;
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    UnilateralRow& r = u.rows[k];
+    if (!r.touching || !r.in_set || r.nf == 0) continue;
+    const auto& sr = cdata_->slide[r.c];
+    double pt = 0;
+    for (int i = 0; i < sr.n; ++i)
+      pt += std::pow(u.impulse[cdata_->offset[r.c] + sr.row[i]] / sr.scale[i], 2);
+    needed = needed || cdata_->isSliding(r.c) ||
+             std::sqrt(pt) > r.mu * std::max(0.0, r.impulse) * (1 + 1e-9);
+    r.first_force = F;
+    F += r.nf;
+    u.onset.push_back(k);
+  }
+  return needed;
+}
+
+/// The released contacts back to their rows; their modes as before unless
+/// `keep_modes`.
+void Simulator::Impl::releaseOnset(bool keep_modes) {
+  auto& u = *uni_;
+  for (int k : u.onset) {
+    u.rows[k].released = false;
+    if (!keep_modes) cdata_->setSliding(u.rows[k].c, u.was_sliding[k] != 0);
+  }
+}
+
+/// The impact problem's maps at (t, q, v⁻), the friction rows released: the
+/// responses to unit friction impulses (V, W, N), Newton's law on the normal
+/// rows alone (v⁰ in u.vplus, Pₙ⁰ in p.ln0) and the slips s⁰ at v⁰ (p.a0).
+bool Simulator::Impl::frictionImpactMaps(int F, std::string& error) {
+  auto& u = *uni_;
+  auto& p = u.onset_problem;
+  const int K = static_cast<int>(u.onset.size());
+  // The responses at (t, q, v⁻): they depend on q only.
+  v_ = u.vminus;
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  frictionUnitForces(u.onset, &UnilateralRow::first_force, p);
+  tau_.setZero();
+  if (!frictionResponses(t_, q_, v_, tau_, u.onset, &UnilateralRow::first_force, F, p, true)) {
+    error = "impact with friction: " + p.res.error;
+    return false;
+  }
+  // Newton's law on the normal rows alone: v⁰ (in u.vplus), Pₙ⁰ (in p.ln0).
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+  shiftImpactTargets();
+  u.vplus = v_;
+  if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
+    error = "impact with friction: the impulse solve failed: " + solver_->lastError();
+    return false;
+  }
+  for (int j = 0; j < K; ++j) p.ln0[j] = -u.impulse[u.rows[u.onset[j]].global];
+  // s⁰: the released rows' slips at v⁰.
+  evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, u.vplus);
+  for (int j = 0; j < K; ++j) {
+    const UnilateralRow& r = u.rows[u.onset[j]];
+    p.a0.segment(r.first_force, r.nf) = cdata_->slide[r.c].slip.head(r.nf);
+  }
+  return true;
+}
+
+/// The settled impulses P (p.f, v_ = v⁺): each contact's normal and friction
+/// impulses for the log and its mode after the impact. false (the impact
+/// undone) when they would pull a contact, `separating` naming it when it
+/// was at rest.
+bool Simulator::Impl::applyFrictionImpulses(int F, int& separating, std::string& error) {
+  auto& u = *uni_;
+  const ContactEventOptions& o = options_.contacts;
+  auto& p = u.onset_problem;
+  const int K = static_cast<int>(u.onset.size());
   for (int j = 0; j < K; ++j) {
     const int k = u.onset[j];
     UnilateralRow& r = u.rows[k];
     const auto& sr = cdata_->slide[r.c];
     const double pn = p.loadAt(j, F);
     if (pn < -o.force_tol) {
-      restore(false);
+      releaseOnset(false);
       v_ = u.vstick;
       if (r.gamma >= -o.speed_tol) separating = k;  // at rest: it may separate instead
       error = "impact with friction: the friction impulses would pull contact '" +
@@ -178,8 +216,6 @@ bool Simulator::frictionImpact(std::string& error, int& separating) {
     if (slides && !was) logEvent(ContactEventKind::Slip, k, 0, slip.norm(), 0);
     if (!slides && was) logEvent(ContactEventKind::Stick, k, 0, 0, 0);
   }
-  restore(true);
-  forwardKinematics(model_, *data_, q_, v_);
   return true;
 }
 

@@ -33,7 +33,7 @@
 #include <appell/kinematics.hpp>
 #include <appell/simulator.hpp>
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/simulator_impl.hpp"
 
 #include <cmath>
 
@@ -41,7 +41,7 @@ namespace appell {
 
 using detail::UnilateralRow;
 
-int Simulator::overconstrainedContact(double t, const VecX& q, const VecX& v) {
+int Simulator::Impl::overconstrainedContact(double t, const VecX& q, const VecX& v) {
   auto& u = *uni_;
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t, q, v);
   u.onset.clear();  // capacity reserved: no allocation

@@ -38,7 +38,7 @@
 #include <appell/kinematics.hpp>
 #include <appell/simulator.hpp>
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/simulator_impl.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -151,7 +151,7 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
 
 }  // namespace
 
-bool Simulator::solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
+bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
                               ConstrainedResult& out, SolveOutputs outputs) {
   auto& u = *uni_;
   const double settle_time = options_.contacts.settle_time;

@@ -4,7 +4,7 @@
 #include <appell/simulator.hpp>
 #include <appell/tree_solver.hpp>
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/simulator_impl.hpp"
 #include "timestepping/moreau_jean.hpp"
 
 #include <cmath>
@@ -13,9 +13,9 @@
 
 namespace appell {
 
-Simulator::Simulator(const Model& model, ConstraintList constraints,
-                     std::unique_ptr<ConstrainedSolver> solver, IntegratorType integrator,
-                     const IntegratorOptions& integrator_options, const SimulatorOptions& options)
+Simulator::Impl::Impl(const Model& model, ConstraintList constraints,
+                      std::unique_ptr<ConstrainedSolver> solver, IntegratorType integrator,
+                      const IntegratorOptions& integrator_options, const SimulatorOptions& options)
     : model_(model), constraints_(std::move(constraints)), solver_(std::move(solver)),
       integrator_(makeIntegrator(integrator, model, integrator_options)), options_(options) {
   if (!solver_) throw std::invalid_argument("Simulator: no constrained solver given");
@@ -67,9 +67,9 @@ Simulator::Simulator(const Model& model, ConstraintList constraints,
   field_->clear();
 }
 
-Simulator::~Simulator() = default;
+Simulator::Impl::~Impl() = default;
 
-bool Simulator::setState(double t, const VecX& q, const VecX& v) {
+bool Simulator::Impl::setState(double t, const VecX& q, const VecX& v) {
   if (q.size() != model_.nq || v.size() != model_.nv)
     throw std::invalid_argument("Simulator::setState: q must have size nq = " +
                                 std::to_string(model_.nq) + " and v size nv = " +
@@ -110,7 +110,7 @@ bool Simulator::setState(double t, const VecX& q, const VecX& v) {
 // clearance open, the touching ones decided (impact, then forces), each on
 // its nearest piece. The points of a pair close one per pass: each next one
 // searches past the pieces the closed ones hold.
-bool Simulator::decideContactModes(std::string& error) {
+bool Simulator::Impl::decideContactModes(std::string& error) {
   for (auto& r : uni_->rows) cdata_->setActive(r.c, false);
   for (bool more = true; more;) {
     more = false;
@@ -132,21 +132,20 @@ bool Simulator::decideContactModes(std::string& error) {
   return ok;
 }
 
-void Simulator::setJointForces(JointForces tau) {
+void Simulator::Impl::setJointForces(JointForces tau) {
   tau_fn_ = std::move(tau);
   integrator_->reset();  // a carried stage holds the old forces' acceleration
 }
 
-int Simulator::partitionChanges() const { return solver_->partitionChanges(); }
 
-const ContactFrame& Simulator::contactFrame(int constraint) const {
+const ContactFrame& Simulator::Impl::contactFrame(int constraint) const {
   if (constraint < 0 || constraint >= static_cast<int>(cdata_->blocks.size()))
     throw std::out_of_range("Simulator::contactFrame: no constraint " +
                             std::to_string(constraint));
   return cdata_->blocks[constraint].frame;
 }
 
-void Simulator::restore() {
+void Simulator::Impl::restore() {
   t_ = t_prev_;
   q_ = q_prev_;
   v_ = v_prev_;
@@ -156,7 +155,7 @@ void Simulator::restore() {
   evaluateEndState(ignored);
 }
 
-StepStatus Simulator::fail(StepStatus st, std::string message) {
+StepStatus Simulator::Impl::fail(StepStatus st, std::string message) {
   restore();
   st.ok = false;
   st.message = std::move(message);
@@ -166,7 +165,7 @@ StepStatus Simulator::fail(StepStatus st, std::string message) {
 
 // Reports of the current state: constraint rows, residuals, energy and, when
 // asked, the dynamics (λ, contact forces) at (t, q, v).
-bool Simulator::evaluateEndState(std::string& error) {
+bool Simulator::Impl::evaluateEndState(std::string& error) {
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   velocity_residual_ = appell::velocityResidual(*data_, constraints_, *cdata_, v_);
   gap_residual_ = appell::gapResidual(*cdata_);
@@ -190,7 +189,7 @@ bool Simulator::evaluateEndState(std::string& error) {
   return ok;
 }
 
-StepStatus Simulator::projectState() {
+StepStatus Simulator::Impl::projectState() {
   StepStatus st;
   t_prev_ = t_;
   q_prev_ = q_;
@@ -206,11 +205,11 @@ StepStatus Simulator::projectState() {
   return st;
 }
 
-void Simulator::takeStepWork(const StepResult& r) {
+void Simulator::Impl::takeStepWork(const StepResult& r) {
   for (int i = 0; i < kWorkTerms; ++i) work_[i] = work_prev_[i] + r.integrals[i];
 }
 
-StepStatus Simulator::step(double h) {
+StepStatus Simulator::Impl::step(double h) {
   if (!(h > 0) || !std::isfinite(h)) {
     std::ostringstream os;
     os << "Simulator::step: the step size must be positive and finite (got " << h << ")";
@@ -254,26 +253,15 @@ StepStatus Simulator::step(double h) {
   return st;
 }
 
-StepStatus Simulator::attemptStep(double h) {
+// One step from the current state, as its stages: integrate, watch (a
+// change of terrain piece is located at once; a contact point that jumped is
+// an impact here), project the drift, evaluate the end state, watch the
+// event functions, and locate and resolve the first crossing — or accept
+// the contacts' modes and pieces as they are.
+StepStatus Simulator::Impl::attemptStep(double h) {
   StepStatus st;
-  field_->clear();
-  const StepResult r = integrator_->step(*field_, t_, q_, v_, h);
-  takeStepWork(r);
-  st.h_taken = r.h_taken;
-  st.h_next = r.h_next;
-  st.rejected = r.rejected;
-  st.evaluations = r.evaluations;
-  counters_.rejected += r.rejected;
-  counters_.evaluations += r.evaluations;
-  if (!r.ok) {
-    if (field_->failed()) return fail(st, field_->message());
-    if (r.failure) return fail(st, r.failure);
-    return fail(st, integrator_->adaptive()
-                        ? "the step size fell below h_min (the dynamics are too stiff or singular here)"
-                        : "the integrator produced a non-finite state");
-  }
-  if (!std::isfinite(t_) || !q_.allFinite() || !v_.allFinite())
-    return fail(st, "the integrator produced a non-finite state");
+  std::string error;
+  if (!integrateStep(h, st, error)) return fail(st, error);
   bool rows_current = false;  // cdata_ holds the rows at (t_, q_): the projection need not redo them
   if (uni_ && options_.contacts.enabled) {
     // A closed contact that moved onto another piece of a terrain inside
@@ -285,46 +273,16 @@ StepStatus Simulator::attemptStep(double h) {
       return st;
     }
     rows_current = searchedRowsLatched();
-    std::string error;
     if (!pointJumpImpact(error, rows_current))
       return fail(st, "at t = " + std::to_string(t_) + ": " + error);
   }
-
-  // Drift control: positions onto the gaps, then velocities onto A v + b = 0.
-  // The integrator is told how far that moved the state (it may keep its
-  // FSAL stage for a move within its tolerance).
-  const bool projecting = options_.project_positions || options_.project_velocities;
-  if (projecting) {
-    q_moved_ = q_;
-    v_moved_ = v_;
-  }
-  if (options_.project_positions) {
-    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_, rows_current);
-    st.projection_iterations = projection_.iterations;
-    counters_.projection_iterations += projection_.iterations;
-    if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
-  }
-  if (options_.project_velocities && cdata_->m_active > 0) {
-    if (!options_.project_positions && !rows_current)
-      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
-      field_->noteFailure(t_, q_, v_);
-      return fail(st, "velocity projection failed: " + solver_->lastError());
-    }
-  }
-  if (projecting) {
-    difference(model_, q_moved_, q_, dtheta_moved_);
-    v_moved_ = v_ - v_moved_;
-    integrator_->stateMoved(dtheta_moved_, v_moved_);
-  }
-
-  std::string error;
+  if (!projectDrift(st, rows_current, error)) return fail(st, error);
   if (!evaluateEndState(error)) {
     field_->noteFailure(t_, q_, v_);
     return fail(st, error);
   }
   // Unilateral constraints: a gap or a normal force that changed sign over
-  // the step means an event inside it (contact_events.cpp).
+  // the step means an event inside it (event_watch.cpp, event_location.cpp).
   detail::Crossing crossing = detail::Crossing::None;
   if (uni_ && options_.contacts.enabled && crossedConstraint(crossing) >= 0) {
     st = locateAndHandleEvent(st, st.h_taken);
@@ -340,9 +298,73 @@ StepStatus Simulator::attemptStep(double h) {
   return st;
 }
 
+/// The integrate stage: the integrator's step over the acceleration field
+/// from the current state, its work integrals and counts. false with the
+/// reason when it failed or left a non-finite state.
+bool Simulator::Impl::integrateStep(double h, StepStatus& st, std::string& error) {
+  field_->clear();
+  const StepResult r = integrator_->step(*field_, t_, q_, v_, h);
+  takeStepWork(r);
+  st.h_taken = r.h_taken;
+  st.h_next = r.h_next;
+  st.rejected = r.rejected;
+  st.evaluations = r.evaluations;
+  counters_.rejected += r.rejected;
+  counters_.evaluations += r.evaluations;
+  if (!r.ok) {
+    if (field_->failed()) error = field_->message();
+    else if (r.failure) error = r.failure;
+    else
+      error = integrator_->adaptive()
+                  ? "the step size fell below h_min (the dynamics are too stiff or singular here)"
+                  : "the integrator produced a non-finite state";
+    return false;
+  }
+  if (!std::isfinite(t_) || !q_.allFinite() || !v_.allFinite()) {
+    error = "the integrator produced a non-finite state";
+    return false;
+  }
+  return true;
+}
+
+/// The project stage (drift control): positions onto the gaps, then
+/// velocities onto A v + b = 0. The integrator is told how far that moved
+/// the state (it may keep its FSAL stage for a move within its tolerance).
+bool Simulator::Impl::projectDrift(StepStatus& st, bool rows_current, std::string& error) {
+  const bool projecting = options_.project_positions || options_.project_velocities;
+  if (projecting) {
+    q_moved_ = q_;
+    v_moved_ = v_;
+  }
+  if (options_.project_positions) {
+    projection_ = projector_->project(model_, *data_, constraints_, *cdata_, t_, q_, rows_current);
+    st.projection_iterations = projection_.iterations;
+    counters_.projection_iterations += projection_.iterations;
+    if (!projection_.ok) {
+      error = "position projection failed: " + projection_.error;
+      return false;
+    }
+  }
+  if (options_.project_velocities && cdata_->m_active > 0) {
+    if (!options_.project_positions && !rows_current)
+      evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
+    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
+      field_->noteFailure(t_, q_, v_);
+      error = "velocity projection failed: " + solver_->lastError();
+      return false;
+    }
+  }
+  if (projecting) {
+    difference(model_, q_moved_, q_, dtheta_moved_);
+    v_moved_ = v_ - v_moved_;
+    integrator_->stateMoved(dtheta_moved_, v_moved_);
+  }
+  return true;
+}
+
 // The loop is run_loop.cpp's, carrying this simulator's step suggestion.
 StepStatus Simulator::advanceTo(double t_end, double h) {
-  return detail::advanceCarrying(*this, t_end, h, h_suggest_, t_);
+  return detail::advanceCarrying(*this, t_end, h, impl_->h_suggest_, impl_->t_);
 }
 
 }  // namespace appell

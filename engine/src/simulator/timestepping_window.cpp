@@ -20,7 +20,7 @@
 #include <appell/dynamics.hpp>
 #include <appell/simulator.hpp>
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/simulator_impl.hpp"
 #include "timestepping/moreau_jean.hpp"
 
 #include <new>
@@ -72,7 +72,7 @@ void timestepping::checkOptions(const TimeSteppingOptions& o) {
         "stable_steps ≥ 1 are required");
 }
 
-bool Simulator::timeSteppingStage() {
+bool Simulator::Impl::timeSteppingStage() {
   if (mj_ || !uni_) return mj_ != nullptr;
   try {
     mj_ = std::make_unique<timestepping::MoreauJean>(model_, constraints_, options_.timestepping,
@@ -83,7 +83,7 @@ bool Simulator::timeSteppingStage() {
   return true;
 }
 
-bool Simulator::openTimeSteppingWindow(const std::string& why) {
+bool Simulator::Impl::openTimeSteppingWindow(const std::string& why) {
   if (options_.scheme != ContactScheme::Auto || stepping_ || !options_.contacts.enabled ||
       !timeSteppingStage())
     return false;
@@ -92,7 +92,7 @@ bool Simulator::openTimeSteppingWindow(const std::string& why) {
 }
 
 /// The unilateral constraint a message names ('name'), or the first one.
-int Simulator::namedContact(const std::string& message) const {
+int Simulator::Impl::namedContact(const std::string& message) const {
   int first = -1;
   for (const auto& r : uni_->rows) {
     if (first < 0) first = r.c;
@@ -101,7 +101,7 @@ int Simulator::namedContact(const std::string& message) const {
   return first;
 }
 
-void Simulator::openWindow(int constraint, std::string why) {
+void Simulator::Impl::openWindow(int constraint, std::string why) {
   // Soon after the last window closed: the events failed again, so this
   // one lasts twice as long.
   const double min_window = options_.timestepping.min_window;
@@ -118,7 +118,7 @@ void Simulator::openWindow(int constraint, std::string why) {
 }
 
 // The event scheme again, if it decides the modes at the window's end.
-bool Simulator::closeWindow() {
+bool Simulator::Impl::closeWindow() {
   q_moved_ = q_;  // (the drift projection's scratch: no allocation)
   v_moved_ = v_;
   const double dissipated = dissipated_;
@@ -147,7 +147,7 @@ bool Simulator::closeWindow() {
 
 // Zeno and collapse watches of the automatic scheme, after an event step.
 constexpr bool kCollapseWatch = false;
-void Simulator::watchEvents(const StepStatus& st) {
+void Simulator::Impl::watchEvents(const StepStatus& st) {
   const TimeSteppingOptions& o = options_.timestepping;
   // Mode changes only: a contact crossing a terrain's pieces keeps its mode.
   int logged = 0;
@@ -184,7 +184,7 @@ void Simulator::watchEvents(const StepStatus& st) {
   }
 }
 
-StepStatus Simulator::timeSteppingStep(double h) {
+StepStatus Simulator::Impl::timeSteppingStep(double h) {
   StepStatus st;
   const double hs = std::min(h, options_.timestepping.step);
   if (window_contact_ >= 0) {  // a window opened since the last step: log it

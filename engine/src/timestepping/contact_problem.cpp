@@ -2,7 +2,7 @@
 // (contact_problem.hpp states the problem and the residual).
 #include "timestepping/contact_problem.hpp"
 
-#include "simulator/simulator_internal.hpp"
+#include "simulator/friction_problem.hpp"
 
 #include <Eigen/Cholesky>
 

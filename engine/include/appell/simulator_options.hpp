@@ -1,0 +1,109 @@
+// The simulator's options (contact scheme, time-stepping, projection, contact
+// events) and what it reports (StepStatus per step, SimulatorCounters over a
+// run): the plain data a user sets and reads around appell/simulator.hpp.
+// validateOptions is in simulator/options.cpp.
+#pragma once
+
+#include <appell/constrained_dynamics.hpp>
+#include <appell/contact_events.hpp>
+#include <appell/projection.hpp>
+
+#include <span>
+#include <string>
+
+namespace appell {
+
+/// Which scheme handles the unilateral contacts (docs/contacts.md §10).
+enum class ContactScheme {
+  Events,        ///< event-driven: exact mode switches, located events (§7–8)
+  TimeStepping,  ///< Moreau–Jean: velocity-level impulses per fixed step
+  Auto,          ///< events, with time-stepping windows where they fail or pile up
+};
+/// "events", "timestepping" (time_stepping, moreau_jean), "auto": the names
+/// of --contacts, the scene's <simulation contacts="…"> and the Python option.
+std::span<const NamedValue<ContactScheme>> contactSchemeTable();
+const char* toString(ContactScheme scheme);
+/// Parses any name of contactSchemeTable(); throws std::invalid_argument otherwise.
+ContactScheme contactSchemeFromString(const std::string& name);
+
+/// The time-stepping scheme and the automatic switch (docs/contacts.md §10).
+struct TimeSteppingOptions {
+  double step = 1e-3;        ///< h of a Moreau–Jean step (s); a shorter requested step is taken
+  /// q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v). θ = 1: a contact's gap target
+  /// (u⁺ₙ ≥ −g/h) lands it on g = 0 at the step's end; below 1 a landing
+  /// penetrates by O(h u⁻ₙ), pushed out over the next step.
+  double theta = 1.0;
+  /// The contact problem is solved until the natural-map residual of the
+  /// Coulomb law in De Saxcé's form is below residual_tol · max(1, |u_free|∞)
+  /// (m/s) or max_sweeps Gauss–Seidel sweeps are done (counted, never fatal).
+  double residual_tol = 1e-10;
+  int max_sweeps = 2000;
+  // auto: when a window starts …
+  int zeno_events = 64;      ///< … this many events within zeno_time (s) of simulated time
+  double zeno_time = 1e-2;
+  int collapse_steps = 200;  ///< … or that many steps advance less than collapse_step each on average
+  double collapse_step = 1e-7;
+  // … and when it ends: at least min_window (s, doubled each time the events
+  // fail again within a window's length of its end), the contact modes
+  // unchanged over stable_steps steps, and the event scheme's modes decided.
+  double min_window = 0.05;
+  int stable_steps = 50;
+};
+
+struct SimulatorOptions {
+  bool project_positions = true;   ///< Newton on the holonomic gaps after every step
+  bool project_velocities = true;  ///< impulse solve after every step
+  ProjectionOptions projection;
+  BaumgarteOptions baumgarte;      ///< off by default (projection is the method)
+  /// Solve the dynamics at the end of each step, so lambda() and contact
+  /// frames describe the current state (one extra solve per step). Needed
+  /// for lift-off detection: with it off, closed contacts never open.
+  bool evaluate_end_state = true;
+  ContactEventOptions contacts;    ///< unilateral contacts: events, impacts
+  ContactScheme scheme = ContactScheme::Auto;
+  TimeSteppingOptions timestepping;
+};
+
+/// Throws std::invalid_argument naming the first option that is NaN, infinite,
+/// negative where it must not be, or an iteration count below one
+/// (simulator/options.cpp). The Simulator's constructor calls it.
+void validateOptions(const SimulatorOptions& options);
+
+struct StepStatus {
+  bool ok = true;
+  std::string message;   ///< why !ok (empty on success)
+  double h_taken = 0;
+  double h_next = 0;     ///< the integrator's suggestion (adaptive) or h
+  int rejected = 0;
+  int evaluations = 0;
+  int projection_iterations = 0;
+  int events = 0;        ///< contact events at the end of this step (events())
+};
+
+struct SimulatorCounters {
+  long steps = 0;                  ///< accepted steps
+  long rejected = 0;               ///< rejected attempts (adaptive)
+  long evaluations = 0;            ///< dynamics solves by the integrator
+  long failed = 0;                 ///< step() calls that returned !ok
+  long projection_iterations = 0;  ///< Newton iterations of the position projection
+  long events = 0;                 ///< contact events (touchdown, bounce, lift-off)
+  long event_steps = 0;            ///< extra steps taken to locate events
+  /// Friction onsets whose joint problem did not settle (its modes were then
+  /// decided one contact at a time: docs/contacts.md §8).
+  long friction_onset_unsettled = 0;
+  /// Solves whose sliding contacts' settled directions did not settle (they
+  /// then slid along their slips: friction_settled.cpp).
+  long settle_unsettled = 0;
+  /// Steps redone because their sticking contacts became over-constrained
+  /// (one then slides: friction_overconstrained.cpp).
+  long overconstrained = 0;
+  /// Time-stepping (docs/contacts.md §10): steps taken by it, the windows the
+  /// automatic scheme opened, contact problems that hit max_sweeps, and the
+  /// largest residual of a solved one.
+  long timestepping_steps = 0;
+  long windows = 0;
+  long unconverged = 0;
+  double max_contact_residual = 0;
+};
+
+}  // namespace appell

@@ -1,0 +1,143 @@
+// The unilateral constraints' workspace, built once at construction: one
+// detail::UnilateralRow per unilateral constraint (its row, bodies, contact
+// law checked), the points of one pair linked, and every buffer of the
+// event, impact, force and friction stages sized for all of them — so that
+// no stage allocates inside a step.
+#include <appell/simulator.hpp>
+
+#include "simulator/simulator_impl.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace appell {
+
+using detail::UnilateralRow;
+
+/// Throws std::invalid_argument naming the constraint when its contact law
+/// (restitution, friction, kinetic friction, creep speed) is outside its range (restitution in [0, 1], 0 ≤ μₖ ≤ μ, a finite creep
+/// speed ≥ 0).
+static void checkContactLaw(const Constraint& con) {
+  const double e = con.restitution();
+  if (!(e >= 0 && e <= 1))
+    throw std::invalid_argument("Simulator: constraint '" + con.name() +
+                                "' has restitution " + std::to_string(e) + " outside [0, 1]");
+  const double mu = con.friction();
+  if (!(mu >= 0))
+    throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has friction μ = " +
+                                std::to_string(mu) + " (must be ≥ 0)");
+  const double mu_k = con.kineticFriction();
+  if (!(mu_k >= 0 && mu_k <= mu))
+    throw std::invalid_argument("Simulator: constraint '" + con.name() +
+                                "' has kinetic friction μₖ = " + std::to_string(mu_k) +
+                                " outside [0, μ = " + std::to_string(mu) + "]");
+  const double creep = con.creepSpeed();
+  if (!(creep >= 0 && std::isfinite(creep)))
+    throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has creep speed " +
+                                std::to_string(creep) + " (must be ≥ 0 and finite)");
+}
+
+/// The row of unilateral constraint c, its contact law checked.
+static UnilateralRow unilateralRowOf(const ConstraintList& constraints, const ConstraintData& cd,
+                                     int c) {
+  const Constraint& con = *constraints[c];
+  UnilateralRow r;
+  r.c = c;
+  r.row = con.unilateralRow();
+  if (r.row >= con.rows())
+    throw std::invalid_argument("Simulator: constraint '" + con.name() +
+                                "' names unilateral row " + std::to_string(r.row) + " of " +
+                                std::to_string(con.rows()));
+  r.global = cd.offset[c] + r.row;
+  r.joint = con.jointSpace();
+  r.a = con.bodyA();
+  r.b = con.bodyB();
+  if (r.joint) {
+    r.cols = cd.blocks[c].joint_cols;
+    r.a_joint = VecX::Zero(static_cast<int>(r.cols.size()));
+  }
+  checkContactLaw(con);
+  const double mu = con.friction();
+  if (std::isfinite(mu) && cd.slide[c].n > 0) {
+    r.mu = mu;
+    r.mu_k = con.kineticFriction();
+    r.nf = cd.slide[c].n;
+    r.creep = con.creepSpeed();
+  }
+  r.slot = con.pointSlot();
+  return r;
+}
+
+void Simulator::Impl::setUpUnilateral() {
+  for (int c = 0; c < static_cast<int>(constraints_.size()); ++c) {
+    if (!constraints_[c]->unilateral()) continue;
+    if (!uni_) uni_ = std::make_unique<detail::UnilateralState>();
+    uni_->rows.push_back(unilateralRowOf(constraints_, *cdata_, c));
+  }
+  if (!uni_) return;
+  for (const auto& r : uni_->rows)  // regularized friction: closed means sliding
+    if (cdata_->regularized[r.c] && cdata_->isActive(r.c)) cdata_->setSliding(r.c, true);
+  linkPointGroups();
+  sizeUnilateralWorkspace();
+}
+
+/// Points of one pair (Constraint::pointGroup): each one's siblings.
+void Simulator::Impl::linkPointGroups() {
+  auto& u = *uni_;
+  for (int i = 0; i < static_cast<int>(u.rows.size()); ++i) {
+    const void* group = constraints_[u.rows[i].c]->pointGroup();
+    if (!group) continue;
+    for (int j = 0; j < static_cast<int>(u.rows.size()); ++j)
+      if (j != i && constraints_[u.rows[j].c]->pointGroup() == group) {
+        if (u.rows[j].slot == u.rows[i].slot)
+          throw std::invalid_argument("Simulator: contacts '" +
+                                      constraints_[u.rows[i].c]->name() + "' and '" +
+                                      constraints_[u.rows[j].c]->name() +
+                                      "' are the same point of one pair");
+        u.rows[i].siblings.push_back(j);
+      }
+    if (u.rows[i].siblings.size() > cdata_->blocks[u.rows[i].c].excluded_features.size())
+      throw std::invalid_argument("Simulator: contact '" + constraints_[u.rows[i].c]->name() +
+                                  "' has more than 4 points");
+  }
+}
+
+/// Every buffer of the unilateral stages, at its largest size.
+void Simulator::Impl::sizeUnilateralWorkspace() {
+  auto& u = *uni_;
+  u.q0 = q_;
+  u.v0 = v_;
+  u.vplus = v_;
+  u.vminus = v_;
+  u.vdot = VecX::Zero(model_.nv);
+  u.impulse = VecX::Zero(cdata_->m);
+  u.res.vdot = VecX::Zero(model_.nv);
+  u.res.lambda = VecX::Zero(cdata_->m);
+  u.res.reaction = VecX::Zero(model_.nv);
+  events_.reserve(64);
+  int kf = 0;
+  for (const auto& r : u.rows) kf += r.nf > 0 ? 1 : 0;
+  u.sliding.reserve(u.rows.size());
+  u.G = MatX::Zero(model_.nv, kf);
+  u.J = MatX::Zero(6, model_.nv);
+  u.R = MatX::Zero(kf, kf);
+  u.lam0 = VecX::Zero(kf);
+  u.s = VecX::Zero(kf);
+  u.tau_f = VecX::Zero(model_.nv);
+  u.unit = u.res;
+  int nf = 0;
+  for (const auto& r : u.rows) nf += r.nf;
+  u.onset.reserve(u.rows.size());
+  u.was_sliding.assign(u.rows.size(), 0);
+  u.onset_problem.size(model_.nv, nf, kf, u.res);
+  u.settle.reserve(u.rows.size());
+  u.settle_problem.size(model_.nv, nf, kf, u.res);
+  u.swmax = VecX::Zero(kf);
+  u.vstick = VecX::Zero(model_.nv);
+  u.over_W = MatX::Zero(nf, nf);
+  u.over_g = VecX::Zero(nf);
+  u.over_eig = Eigen::SelfAdjointEigenSolver<MatX>(nf);
+  u.feature_ahead.assign(u.rows.size(), -1);
+}
+
+}  // namespace appell
