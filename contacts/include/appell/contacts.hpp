@@ -74,7 +74,7 @@ struct ContactSpec {
   /// (docs/contacts.md §8). NaN: none (the spin row is ideal while the
   /// contact sticks and free while it slides). Needs a finite μ > 0.
   double mu_spin = std::numeric_limits<double>::quiet_NaN();
-  /// Regularized friction (Constraint::creepSpeed): the slip speed v_c > 0
+  /// Regularized friction (ContactLaw::creep_speed): the slip speed v_c > 0
   /// (m/s) below which the friction force grows linearly with the slip,
   /// μₖλₙ s/v_c, instead of sticking. 0: Coulomb, with sticking. Needs a
   /// finite μ > 0 and a unilateral contact.
@@ -112,18 +112,9 @@ class ShapeContact : public Constraint {
   bool holonomic(int k) const override;
   /// The normal row, when the contact is unilateral (spec().unilateral).
   int unilateralRow() const override;
-  double restitution() const override { return spec_.restitution; }
-  /// Coulomb's μ of the tangent/lateral rows (spec().mu; ∞: ideal rolling).
-  double friction() const override { return spec_.mu; }
-  double kineticFriction() const override {
-    return std::isnan(spec_.mu_kinetic) ? spec_.mu : spec_.mu_kinetic;
-  }
-  double spinFriction() const override { return spec_.mu_spin; }
-  double creepSpeed() const override { return spec_.creep_speed; }
-  /// makeContactPoints: the pair's description (shared by its points) and
-  /// this point's index; null and 0 for a single contact.
-  const void* pointGroup() const override { return group_.get(); }
-  int pointSlot() const override { return slot_; }
+  // Its ContactLaw (Constraint::contactLaw) is the spec's μ, μₖ (μ when
+  // unset), spin length, creep speed and restitution; makeContactPoints
+  // gives the points of one pair a common group id and their slots.
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;
@@ -167,8 +158,6 @@ class ShapeContact : public Constraint {
   ContactSpec spec_;
   Vec3 blade_ = Vec3::Zero();
   int rows_ = 0;
-  std::shared_ptr<const ContactSpec> group_;
-  int slot_ = 0;
 };
 
 /// Builds a contact from a declarative description. Throws std::invalid_argument

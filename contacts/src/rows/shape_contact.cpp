@@ -7,6 +7,8 @@
 
 #include <appell/name_table.hpp>
 
+#include <atomic>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -112,6 +114,11 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
   } catch (const std::invalid_argument& e) {
     fail(e.what());
   }
+  law_.mu = spec_.mu;
+  law_.mu_kinetic = std::isnan(spec_.mu_kinetic) ? spec_.mu : spec_.mu_kinetic;
+  law_.spin = spec_.mu_spin;
+  law_.creep_speed = spec_.creep_speed;
+  law_.restitution = spec_.restitution;
   if (auto* p = std::get_if<Plane>(&support.surface)) p->normal.normalize();
   // Face normals, adjacency and FCL's hierarchy, once (evaluation must not allocate).
   if (auto* t = std::get_if<TerrainMesh>(&support.surface); t && !t->index)
@@ -218,9 +225,9 @@ void ShapeContact::writeRows(const SE3& body_pose, const Vec6& body_velocity,
                              const SupportState& S, RowBlock& out) const {
   ContactGeometry g;
   contactGeometry(spec_.shape, spec_.support.surface, S, body_pose, body_velocity, g,
-                  spec_.options.geometry, out.latched_feature,
-                  std::span<const int>(out.excluded_features.data(), out.excluded_count));
-  out.feature = g.feature;
+                  spec_.options.geometry, out.piece.latched,
+                  std::span<const int>(out.piece.excluded.data(), out.piece.excluded_count));
+  out.piece.feature = g.feature;
   out.m = rows_;
   out.Wa.resize(rows_, 6);
   out.Wb.resize(rows_, 6);
@@ -299,14 +306,17 @@ std::vector<std::shared_ptr<ShapeContact>> makeContactPoints(const ContactSpec& 
   auto first = std::make_shared<ShapeContact>(spec);  // validates, names, builds the index
   if (spec.points == 1) return {first};
   const ContactSpec pair = first->spec();
-  auto group = std::make_shared<const ContactSpec>(pair);
+  // The pair's id: distinct for every pair made in this process (only
+  // equality is read: Constraint::pointGroup).
+  static std::atomic<int> next_pair{0};
+  const int group = next_pair.fetch_add(1, std::memory_order_relaxed);
   std::vector<std::shared_ptr<ShapeContact>> points;
   for (int k = 0; k < pair.points; ++k) {
     ContactSpec one = pair;
     one.options.name = pair.options.name + "/p" + std::to_string(k);
     auto c = std::make_shared<ShapeContact>(std::move(one));
-    c->group_ = group;
-    c->slot_ = k;
+    c->point_group_ = group;
+    c->point_slot_ = k;
     points.push_back(std::move(c));
   }
   return points;

@@ -59,6 +59,24 @@ struct ContactFrame {
   double margin = 1;
 };
 
+/// A contact on a piecewise support (a terrain's flat regions, edges and
+/// vertices): the piece a block's rows are for, and the simulator's choice
+/// of the pieces its search may take (docs/contacts.md §4).
+struct TerrainPiece {
+  /// The piece these rows are for (−1: a smooth support), written by the
+  /// constraint's evaluation.
+  int feature = -1;
+  /// ≥ 0: the contact is evaluated on that piece, extended past its bounds,
+  /// instead of the nearest one — the simulator keeps a closed contact on
+  /// one piece between events.
+  int latched = -1;
+  /// A search's pieces to skip (the first `excluded_count`): the ones the
+  /// other points of the same pair hold (Constraint::pointGroup). The search
+  /// then takes only a separate piece — a second place the body touches.
+  std::array<int, 3> excluded{-1, -1, -1};
+  int excluded_count = 0;
+};
+
 /// What one constraint writes when evaluated. Capacity is fixed (≤ 6 body rows),
 /// except the joint-space block, which is sized once by the constraint's setup.
 struct RowBlock {
@@ -73,20 +91,49 @@ struct RowBlock {
   MatX A_joint;                     ///< jointSpace(): m × joint_cols.size()
   VecX b_joint, abias_joint;        ///< jointSpace(): b and Ȧv + ḃ (size m)
   ContactFrame frame;
-  /// A contact on a piecewise support (a terrain's flat regions, edges and
-  /// vertices): the piece these rows are for (−1: a smooth support). With
-  /// `latched_feature` ≥ 0 the contact is evaluated on that piece, extended
-  /// past its bounds, instead of the nearest one: the simulator keeps a
-  /// closed contact on one piece between events (docs/contacts.md §4).
-  int feature = -1;
-  int latched_feature = -1;
-  /// A search's pieces to skip (the first `excluded_count`): the ones the
-  /// other points of the same pair hold (Constraint::pointGroup). The search
-  /// then takes only a separate piece — a second place the body touches.
-  std::array<int, 3> excluded_features{-1, -1, -1};
-  int excluded_count = 0;
+  /// A contact on a piecewise support: which piece its rows are for, and
+  /// which pieces the search may take (TerrainPiece).
+  TerrainPiece piece;
   bool singular = false;            ///< the geometry is singular here (rows unusable)
   std::string singular_reason;      ///< why, when singular (set only then)
+};
+
+/// The law of a unilateral contact, as data (docs/contacts.md §7–8): what
+/// the simulator's impact and friction stages read, one struct for every
+/// kind of contact (shape contacts, joint limits). A new field is one member
+/// here, its check in the simulator's setup (simulator/unilateral_setup.cpp)
+/// and the stage that reads it (docs/architecture.md).
+struct ContactLaw {
+  /// Coulomb's coefficient μ of the friction rows (tangent and lateral rows,
+  /// isTangential()): while |λₜ| ≤ μ λₙ the contact sticks (all rows hold);
+  /// beyond it slides — its friction rows are replaced by the force
+  /// −μₖ λₙ ŝ against the slip direction (docs/contacts.md §8). ∞: never
+  /// slides (ideal rolling).
+  double mu = std::numeric_limits<double>::infinity();
+  /// Coulomb's kinetic coefficient μₖ ≤ μ: a sliding contact's force is
+  /// μₖ λₙ; μ is then the static one, the cone sticking stays in and a
+  /// stopped slip must fit to stick again. Set it with mu (the same: one
+  /// coefficient).
+  double mu_kinetic = std::numeric_limits<double>::infinity();
+  /// Torsional (spin) friction, a length ℓ: a sticking contact's spin row
+  /// holds while its friction (λₜ, τₙ/(ℓ/μ)) stays in the cone μ λₙ — the
+  /// torque alone up to ℓ λₙ — and a sliding one takes the maximally
+  /// dissipating force and torque of that ellipsoid (docs/contacts.md §8).
+  /// NaN: none (the spin row is ideal while sticking, free while sliding).
+  double spin = std::numeric_limits<double>::quiet_NaN();
+  /// Regularized Coulomb friction: a creep speed v_c > 0 (m/s). The contact
+  /// then never sticks: while closed it always carries the friction force
+  ///     f = −μₖ λₙ s / max(|s|, v_c)
+  /// of its slip velocity s — viscous creep μₖλₙ/v_c below v_c, Coulomb's
+  /// μₖλₙ above (Drake's "stiction tolerance"; a tyre's linear range before
+  /// saturation) — so rows that ideal rolling would make nearly dependent
+  /// (four tyres on uneven ground) are never constraints. 0: Coulomb with
+  /// sticking (docs/contacts.md §8). Only read when mu is finite.
+  double creep_speed = 0;
+  /// Newton's coefficient of restitution on the unilateral row at an impact
+  /// (0: plastic).
+  double restitution = 0;
+  // (A compliant contact's stiffness and damping will be fields here.)
 };
 
 class Constraint {
@@ -118,46 +165,32 @@ class Constraint {
   /// reaches 0 (touchdown) — docs/contacts.md §7. −1: bilateral, always closed.
   virtual int unilateralRow() const { return -1; }
   bool unilateral() const { return unilateralRow() >= 0; }
-  /// Newton's coefficient of restitution on the unilateral row at an impact
-  /// (0: plastic). Only read when unilateral().
-  virtual double restitution() const { return 0; }
-  /// Coulomb's coefficient μ of the friction rows (tangent and lateral
-  /// rows, isTangential()): while |λₜ| ≤ μ λₙ the contact sticks (all rows
-  /// hold); beyond it slides — its friction rows are replaced by the force
-  /// −μ λₙ ŝ against the slip direction (docs/contacts.md §8). ∞: never
-  /// slides (ideal rolling). Only read when unilateral().
-  virtual double friction() const { return std::numeric_limits<double>::infinity(); }
-  /// Coulomb's kinetic coefficient μₖ ≤ friction(): a sliding contact's
-  /// force is μₖ λₙ; friction() is then the static one, the cone sticking
-  /// stays in and a stopped slip must fit to stick again. Default: the same.
-  virtual double kineticFriction() const { return friction(); }
-  /// Regularized Coulomb friction: a creep speed v_c > 0 (m/s). The contact
-  /// then never sticks: while closed it always carries the friction force
-  ///     f = −μₖ λₙ s / max(|s|, v_c)
-  /// of its slip velocity s — viscous creep μₖλₙ/v_c below v_c, Coulomb's
-  /// μₖλₙ above (Drake's "stiction tolerance"; a tyre's linear range before
-  /// saturation) — so rows that ideal rolling would make nearly dependent
-  /// (four tyres on uneven ground) are never constraints. 0: Coulomb with
-  /// sticking (docs/contacts.md §8). Only read when friction() is finite.
-  virtual double creepSpeed() const { return 0; }
-  /// Torsional (spin) friction, a length ℓ: a sticking contact's spin row
-  /// holds while its friction (λₜ, τₙ/(ℓ/μ)) stays in the cone μ λₙ — the
-  /// torque alone up to ℓ λₙ — and a sliding one takes the maximally
-  /// dissipating force and torque of that ellipsoid (docs/contacts.md §8).
-  /// NaN: none (the spin row is ideal while sticking, free while sliding).
-  virtual double spinFriction() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// The law of its unilateral row's contact (ContactLaw): data the
+  /// constraint sets at construction, read only when unilateral().
+  const ContactLaw& contactLaw() const { return law_; }
+  // The law's fields one by one (reports, the scene's checks).
+  double restitution() const { return law_.restitution; }
+  double friction() const { return law_.mu; }
+  double kineticFriction() const { return law_.mu_kinetic; }
+  double creepSpeed() const { return law_.creep_speed; }
+  double spinFriction() const { return law_.spin; }
   /// Several points of one pair (a ball that may touch a terrain in a valley
-  /// on both slopes): constraints with the same non-null token are the points
+  /// on both slopes): constraints with the same group id ≥ 0 are the points
   /// of one pair, numbered by pointSlot(). The simulator gives each point the
-  /// pieces its closed siblings hold to skip (RowBlock::excluded_features) and
-  /// lets only the first open point watch for a touchdown.
-  virtual const void* pointGroup() const { return nullptr; }
-  virtual int pointSlot() const { return 0; }
+  /// pieces its closed siblings hold to skip (TerrainPiece::excluded) and
+  /// lets only the first open point watch for a touchdown. −1: a single point.
+  int pointGroup() const { return point_group_; }
+  int pointSlot() const { return point_slot_; }
   /// Constant-size storage the block needs (called once, outside the step).
   virtual void reserve(const Model& model, RowBlock& block) const;
   /// Writes the rows at (q, v, t). `data` holds forwardKinematics(q, v).
   virtual void evaluate(const Model& model, const Data& data, double t, const VecX& q,
                         const VecX& v, RowBlock& out) const = 0;
+
+ protected:
+  ContactLaw law_;        ///< default: ideal rolling (μ = ∞), plastic, no spin friction
+  int point_group_ = -1;  ///< pointGroup()
+  int point_slot_ = 0;    ///< pointSlot()
 };
 
 /// Joint-space row r of `blk` applied to x (size nv): Σₖ A_joint(r, k) x[cols[k]].

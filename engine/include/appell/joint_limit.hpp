@@ -37,7 +37,6 @@ class JointLimit : public Constraint {
   /// its factor pass (a closed limit locks the joint), O(1) per limit.
   std::vector<int> jointColumns(const Model&) const override { return {iv_}; }
   int unilateralRow() const override { return 0; }
-  double restitution() const override { return restitution_; }
   void reserve(const Model& model, RowBlock& block) const override;
   void evaluate(const Model& model, const Data& data, double t, const VecX& q, const VecX& v,
                 RowBlock& out) const override;
@@ -49,7 +48,7 @@ class JointLimit : public Constraint {
  private:
   int joint_, iq_, iv_;
   LimitSide side_;
-  double bound_, sign_, restitution_;
+  double bound_, sign_;
   std::string name_;
 };
 

@@ -6,7 +6,8 @@
 namespace appell {
 
 JointLimit::JointLimit(const Model& model, int joint, LimitSide side, double restitution)
-    : joint_(joint), side_(side), restitution_(restitution) {
+    : joint_(joint), side_(side) {
+  law_.restitution = restitution;
   if (joint < 0 || joint >= model.nbodies)
     throw std::invalid_argument("joint limit: no joint " + std::to_string(joint));
   const Joint& j = model.joints[joint];

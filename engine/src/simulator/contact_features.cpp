@@ -13,7 +13,7 @@
 //
 // So the piece is a mode, like open/closed and sticking/sliding (Pfeiffer &
 // Glocker 1996, ch. 5): between events every closed contact is evaluated on
-// its latched piece, extended past its bounds (RowBlock::latched_feature),
+// its latched piece, extended past its bounds (TerrainPiece::latched),
 // and the dynamics are smooth. After each step one search with the latches
 // off finds each contact's nearest piece; a closed contact whose nearest
 // piece is neither its latched one nor the one it had at the step's start has
@@ -55,13 +55,13 @@ void Simulator::Impl::applyLatches() {
     if (r.joint) continue;
     RowBlock& blk = cdata_->blocks[r.c];
     const bool closed = cdata_->isActive(r.c);
-    blk.latched_feature = closed ? r.feature : -1;
-    blk.excluded_count = 0;
+    blk.piece.latched = closed ? r.feature : -1;
+    blk.piece.excluded_count = 0;
     for (int j : r.siblings) {
       const UnilateralRow& s = rows[j];
       const bool held = cdata_->isActive(s.c), watched = closed && !held && !s.dormant;
       if ((held || watched) && s.feature >= 0)
-        blk.excluded_features[blk.excluded_count++] = s.feature;
+        blk.piece.excluded[blk.piece.excluded_count++] = s.feature;
     }
   }
 }
@@ -79,13 +79,13 @@ static bool switched(const UnilateralRow& r) {
 int Simulator::Impl::searchFeatures() {
   auto& u = *uni_;
   for (const UnilateralRow& r : u.rows)
-    if (!r.joint) cdata_->blocks[r.c].latched_feature = -1;
+    if (!r.joint) cdata_->blocks[r.c].piece.latched = -1;
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   int first = -1;
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
     UnilateralRow& r = u.rows[k];
     if (r.joint) continue;
-    r.feature_free = cdata_->blocks[r.c].feature;
+    r.feature_free = cdata_->blocks[r.c].piece.feature;
     if (first < 0 && cdata_->isActive(r.c) && switched(r)) first = k;
   }
   applyLatches();

@@ -61,7 +61,7 @@ Simulator::Impl::Impl(const Model& model, ConstraintList constraints,
   evaluateEndState(ignored);
   if (uni_)  // each contact starts on its nearest piece
     for (auto& r : uni_->rows)
-      if (!r.joint) r.feature = r.feature_start = r.feature_free = cdata_->blocks[r.c].feature;
+      if (!r.joint) r.feature = r.feature_start = r.feature_free = cdata_->blocks[r.c].piece.feature;
   VecX vdot(model_.nv);
   (*field_)(t_, q_, v_, vdot);
   field_->clear();
@@ -119,7 +119,7 @@ bool Simulator::Impl::decideContactModes(std::string& error) {
     for (auto& r : uni_->rows) {
       if (cdata_->isActive(r.c)) continue;
       r.lifting = r.touching_down = false;
-      r.feature = r.feature_start = r.feature_free = r.joint ? -1 : cdata_->blocks[r.c].feature;
+      r.feature = r.feature_start = r.feature_free = r.joint ? -1 : cdata_->blocks[r.c].piece.feature;
       if (r.dormant || !(cdata_->gap[r.global] <= options_.contacts.gap_tol)) continue;
       cdata_->setActive(r.c, true);
       more = more || !r.siblings.empty();

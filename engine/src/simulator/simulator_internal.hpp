@@ -59,7 +59,7 @@ struct FrictionState {
   double mu = std::numeric_limits<double>::infinity();  // static: the sticking cone
   double mu_k = std::numeric_limits<double>::infinity();  // kinetic: the sliding force
   int nf = 0;             // friction rows (0: frictionless or bilateral)
-  // Regularized friction (Constraint::creepSpeed): > 0, the contact slides
+  // Regularized friction (ContactLaw::creep_speed): > 0, the contact slides
   // whenever closed, dir = s / max(|s|, creep) (|dir| ≤ 1); no stick or
   // slip events, no onset or settling decisions.
   double creep = 0;
@@ -84,10 +84,10 @@ struct SettlingState {
 /// A contact's piece of a piecewise support and its pair (contact_features.cpp).
 struct FeatureState {
   // The piece a closed contact's rows use between events
-  // (RowBlock::latched_feature), the nearest piece at the step's start, and
+  // (TerrainPiece::latched), the nearest piece at the step's start, and
   // the nearest one at the state last searched.
   int feature = -1, feature_start = -1, feature_free = -1;
-  // Points of one pair (Constraint::pointGroup): the other points' rows, this
+  // Points of one pair (ContactLaw::group): the other points' rows, this
   // one's slot, and whether it idles — open while a point of lower slot is
   // open too, which is the one watching for the next touchdown.
   std::vector<int> siblings;

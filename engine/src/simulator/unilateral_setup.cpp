@@ -15,23 +15,24 @@ namespace appell {
 using detail::UnilateralRow;
 
 /// Throws std::invalid_argument naming the constraint when its contact law
-/// (restitution, friction, kinetic friction, creep speed) is outside its range (restitution in [0, 1], 0 ≤ μₖ ≤ μ, a finite creep
+/// is outside its range (restitution in [0, 1], 0 ≤ μₖ ≤ μ, a finite creep
 /// speed ≥ 0).
 static void checkContactLaw(const Constraint& con) {
-  const double e = con.restitution();
+  const ContactLaw& law = con.contactLaw();
+  const double e = law.restitution;
   if (!(e >= 0 && e <= 1))
     throw std::invalid_argument("Simulator: constraint '" + con.name() +
                                 "' has restitution " + std::to_string(e) + " outside [0, 1]");
-  const double mu = con.friction();
+  const double mu = law.mu;
   if (!(mu >= 0))
     throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has friction μ = " +
                                 std::to_string(mu) + " (must be ≥ 0)");
-  const double mu_k = con.kineticFriction();
+  const double mu_k = law.mu_kinetic;
   if (!(mu_k >= 0 && mu_k <= mu))
     throw std::invalid_argument("Simulator: constraint '" + con.name() +
                                 "' has kinetic friction μₖ = " + std::to_string(mu_k) +
                                 " outside [0, μ = " + std::to_string(mu) + "]");
-  const double creep = con.creepSpeed();
+  const double creep = law.creep_speed;
   if (!(creep >= 0 && std::isfinite(creep)))
     throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has creep speed " +
                                 std::to_string(creep) + " (must be ≥ 0 and finite)");
@@ -57,12 +58,12 @@ static UnilateralRow unilateralRowOf(const ConstraintList& constraints, const Co
     r.a_joint = VecX::Zero(static_cast<int>(r.cols.size()));
   }
   checkContactLaw(con);
-  const double mu = con.friction();
-  if (std::isfinite(mu) && cd.slide[c].n > 0) {
-    r.mu = mu;
-    r.mu_k = con.kineticFriction();
+  const ContactLaw& law = con.contactLaw();
+  if (std::isfinite(law.mu) && cd.slide[c].n > 0) {
+    r.mu = law.mu;
+    r.mu_k = law.mu_kinetic;
     r.nf = cd.slide[c].n;
-    r.creep = con.creepSpeed();
+    r.creep = law.creep_speed;
   }
   r.slot = con.pointSlot();
   return r;
@@ -85,8 +86,8 @@ void Simulator::Impl::setUpUnilateral() {
 void Simulator::Impl::linkPointGroups() {
   auto& u = *uni_;
   for (int i = 0; i < static_cast<int>(u.rows.size()); ++i) {
-    const void* group = constraints_[u.rows[i].c]->pointGroup();
-    if (!group) continue;
+    const int group = constraints_[u.rows[i].c]->pointGroup();
+    if (group < 0) continue;
     for (int j = 0; j < static_cast<int>(u.rows.size()); ++j)
       if (j != i && constraints_[u.rows[j].c]->pointGroup() == group) {
         if (u.rows[j].slot == u.rows[i].slot)
@@ -96,7 +97,7 @@ void Simulator::Impl::linkPointGroups() {
                                       "' are the same point of one pair");
         u.rows[i].siblings.push_back(j);
       }
-    if (u.rows[i].siblings.size() > cdata_->blocks[u.rows[i].c].excluded_features.size())
+    if (u.rows[i].siblings.size() > cdata_->blocks[u.rows[i].c].piece.excluded.size())
       throw std::invalid_argument("Simulator: contact '" + constraints_[u.rows[i].c]->name() +
                                   "' has more than 4 points");
   }

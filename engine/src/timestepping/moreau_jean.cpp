@@ -144,8 +144,8 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
     cdata.setSliding(k.c, false);
     // Each contact on its nearest piece of a terrain (no latches: the
     // event scheme's way of keeping a piece between events).
-    cdata.blocks[k.c].latched_feature = -1;
-    cdata.blocks[k.c].excluded_count = 0;
+    cdata.blocks[k.c].piece.latched = -1;
+    cdata.blocks[k.c].piece.excluded_count = 0;
   }
   evaluateConstraintRows(model, data, constraints, cdata, t + h, qnext_, vfree_);
   for (int k = 0; k < static_cast<int>(all_.size()); ++k)
