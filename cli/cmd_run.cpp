@@ -252,7 +252,7 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
         << " time-stepping steps in " << c.windows << " windows, contact problems to "
         << c.max_contact_residual << " m/s"
         << (c.unconverged ? " (" + std::to_string(c.unconverged) + " at max sweeps)" : std::string())
-        << "\n";
+        << ", closed gaps within " << c.max_contact_gap << " m\n";
   out << "wall time    " << r.wall_seconds << " s, "
       << 1e6 * r.wall_seconds / std::max<long>(1, c.steps) << " µs per step\n"
       << "energy       E0 = " << r.energy0 << " J, max |E "

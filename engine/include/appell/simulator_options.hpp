@@ -99,11 +99,13 @@ struct SimulatorCounters {
   long overconstrained = 0;
   /// Time-stepping (docs/contacts.md §10): steps taken by it, the windows the
   /// automatic scheme opened, contact problems that hit max_sweeps, and the
-  /// largest residual of a solved one.
+  /// largest residual of a solved one; the largest |gap| of a contact closed
+  /// at the end of a time-stepping step (O(h): the step's gap targets).
   long timestepping_steps = 0;
   long windows = 0;
   long unconverged = 0;
   double max_contact_residual = 0;
+  double max_contact_gap = 0;
 };
 
 }  // namespace appell
