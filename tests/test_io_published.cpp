@@ -10,6 +10,7 @@
 
 #include "scene_helpers.hpp"
 #include "simulation_helpers.hpp"
+#include "scoped_env.hpp"
 
 #include <gtest/gtest.h>
 
@@ -31,13 +32,7 @@ const std::string kBiped = kPublished + "/ros1/src/humanoids/biped/biped_descrip
 const std::string kCartPrefix = kPublished + "/ament/install/cart_description";
 const std::string kCart = kCartPrefix + "/share/cart_description/urdf/cart_description.urdf";
 
-// An environment variable set for a test's duration (as sourcing a
-// workspace's setup script sets it).
-struct ScopedEnv {
-  ScopedEnv(const char* name, const std::string& value) : name_(name) { ::setenv(name, value.c_str(), 1); }
-  ~ScopedEnv() { ::unsetenv(name_); }
-  const char* name_;
-};
+using test::ScopedEnv;
 
 std::string readText(const std::string& path) {
   std::ifstream in(path);

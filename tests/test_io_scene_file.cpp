@@ -16,6 +16,7 @@
 
 #include "run_command.hpp"
 #include "scene_helpers.hpp"
+#include "scoped_env.hpp"
 
 #include <gtest/gtest.h>
 
@@ -83,20 +84,7 @@ double normalForceSum(const Simulator& sim) {
   return sum;
 }
 
-// An environment variable set for a test's duration, then restored (a
-// later test may read the caller's ROS_PACKAGE_PATH).
-struct ScopedEnv {
-  ScopedEnv(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    ::setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnv() {
-    if (old_) ::setenv(name_, old_->c_str(), 1);
-    else ::unsetenv(name_);
-  }
-  const char* name_;
-  std::optional<std::string> old_;
-};
+using test::ScopedEnv;
 
 }  // namespace
 
