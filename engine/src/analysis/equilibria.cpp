@@ -108,13 +108,210 @@ void validate(const Model& model, const VecX& q, const EquilibriumOptions& opt) 
 
 double maxAbs(const VecX& x) { return x.size() == 0 ? 0.0 : x.lpNorm<Eigen::Infinity>(); }
 
+/// The Gauss–Newton / Levenberg–Marquardt search over x = (θ, λ): the
+/// scaled residual F(q, λ) = 0 (force balance over fs, holonomic gaps over
+/// ls). Updates q, λ and F; returns the iterations taken, and in stop why it
+/// ended short of the tolerance.
+class Search {
+ public:
+  Search(const Model& model, Residual& res, double fs, double ls)
+      : model_(model), res_(res), fs_(fs), ls_(ls), nv_(model.nv), m_(res.m()), ne_(res.ne()),
+        nx_(nv_ + m_), J_(ne_, nx_), Js_(ne_, nx_), D_(nx_), qn_(model.nq) {}
+
+  int run(VecX& q, VecX& lambda, VecX& F, const EquilibriumOptions& opt, std::string& stop) {
+    stop = "iteration limit reached";
+    int it = 0;
+    for (; it < opt.max_iterations; ++it) {
+      if (maxAbs(F) <= opt.tolerance) break;
+      if (!scaledJacobian(q, lambda)) {
+        stop = "a finite-difference probe hit singular geometry (" + res_.lastSingular() + ")";
+        break;
+      }
+      const VecX grad = Js_.transpose() * F;
+      if (grad.norm() <= 1e-13 * std::max(1.0, Js_.norm()) * F.norm()) {
+        stop = "the residual is stationary (a local minimum of ‖F‖ that is not zero)";
+        break;
+      }
+      if (!dampedStep(q, lambda, F)) {
+        stop = "no step reduces the residual (a local minimum of ‖F‖ that is not zero)";
+        break;
+      }
+      if (slow_ >= 30) {
+        stop = "the residual stopped decreasing";
+        break;
+      }
+    }
+    return it;
+  }
+
+ private:
+  /// J = ∂F/∂(θ, λ) at (q, λ), and Js = J D⁻¹ with D its column norms.
+  bool scaledJacobian(const VecX& q, const VecX& lambda) {
+    if (!res_.jacobianTheta(q, lambda, fs_, ls_, Jt_)) return false;
+    VecX Q;
+    res_.at(q, Q);
+    J_.leftCols(nv_) = Jt_;
+    J_.rightCols(m_).setZero();
+    J_.topRightCorner(nv_, m_) = res_.cd().A.transpose() / fs_;
+    // Column scaling, floored: a column that is zero up to finite-difference
+    // noise (a direction along the equilibrium manifold, e.g. a cyclic
+    // coordinate) must not be blown up to unit size — the minimum-norm step
+    // would then move far along it to cancel noise.
+    double cmax = 0;
+    for (int c = 0; c < nx_; ++c) cmax = std::max(cmax, J_.col(c).norm());
+    for (int c = 0; c < nx_; ++c) {
+      D_[c] = std::max(J_.col(c).norm(), 1e-3 * cmax);
+      if (!(D_[c] > 0)) D_[c] = 1.0;
+      Js_.col(c) = J_.col(c) / D_[c];
+    }
+    return true;
+  }
+
+  /// Up to 16 tries of the step with Levenberg–Marquardt damping μ; true
+  /// when one reduced ‖F‖ (and was taken).
+  bool dampedStep(VecX& q, VecX& lambda, VecX& F) {
+    const double scale2 = (Js_.transpose() * Js_).diagonal().maxCoeff();
+    for (int tries = 0; tries < 16; ++tries) {
+      VecX ds;
+      if (mu_ == 0) {
+        // Singular values below the finite-difference noise are rank
+        // deficiency, not directions to follow.
+        Eigen::CompleteOrthogonalDecomposition<MatX> cod(Js_);
+        cod.setThreshold(1e-6);
+        ds = cod.solve(-F);
+      } else {
+        MatX Aug(ne_ + nx_, nx_);
+        Aug << Js_, std::sqrt(mu_) * MatX::Identity(nx_, nx_);
+        VecX rhs = VecX::Zero(ne_ + nx_);
+        rhs.head(ne_) = -F;
+        ds = Eigen::ColPivHouseholderQR<MatX>(Aug).solve(rhs);
+      }
+      const VecX dx = ds.cwiseQuotient(D_);
+      retract(model_, q, dx.head(nv_), qn_);
+      lam_n_ = lambda + dx.tail(m_);
+      if (dx.allFinite() && res_.residual(qn_, lam_n_, fs_, ls_, Fn_) && Fn_.norm() < F.norm()) {
+        slow_ = Fn_.norm() > 0.999 * F.norm() ? slow_ + 1 : 0;
+        q = qn_;
+        lambda = lam_n_;
+        F = Fn_;
+        mu_ = mu_ < 1e-12 * scale2 ? 0.0 : mu_ / 10;
+        return true;
+      }
+      mu_ = mu_ == 0 ? 1e-6 * scale2 : mu_ * 10;
+    }
+    return false;
+  }
+
+  const Model& model_;
+  Residual& res_;
+  const double fs_, ls_;
+  const int nv_, m_, ne_, nx_;
+  MatX Jt_, J_, Js_;
+  VecX D_, qn_, Fn_, lam_n_;
+  double mu_ = 0;
+  int slow_ = 0;
+};
+
+/// First or second kind: can the holonomic rows alone hold Q? The force
+/// the holonomic rows leave unbalanced.
+double holonomicResidual(const ConstraintData& cd, const VecX& Q, int nv) {
+  const int m = cd.m;
+  std::vector<int> hrows;
+  for (int r = 0; r < m; ++r)
+    if (cd.holonomic[r]) hrows.push_back(r);
+  if (static_cast<int>(hrows.size()) == m) return 0;  // no nonholonomic row: the first kind by definition
+  if (hrows.empty()) return maxAbs(Q);
+  MatX Ah(nv, hrows.size());
+  for (std::size_t k = 0; k < hrows.size(); ++k) Ah.col(k) = cd.A.row(hrows[k]).transpose();
+  Eigen::CompleteOrthogonalDecomposition<MatX> cod(Ah);
+  cod.setThreshold(1e-10);
+  const VecX lh = cod.solve(-Q);
+  return maxAbs(Q + Ah * lh);
+}
+
+/// The final report at q: minimum-norm multipliers, residuals, rank, kind.
+void reportAt(Residual& res, const VecX& q, double fs, double ls, double tol, int nv,
+              EquilibriumResult& out) {
+  VecX Q;
+  res.at(q, Q);
+  const ConstraintData& cd = res.cd();
+  const int m = cd.m;
+  out.q = q;
+  out.generalized_force = Q;
+  if (m > 0) {
+    Eigen::CompleteOrthogonalDecomposition<MatX> cod(cd.A.transpose());
+    cod.setThreshold(1e-10);
+    out.lambda = cod.solve(-Q);
+    out.rank_A = static_cast<int>(cod.rank());
+  } else {
+    out.lambda = VecX();
+  }
+  out.redundant_rows = m - out.rank_A;
+  out.holonomic_residual = holonomicResidual(cd, Q, nv);
+  // A margin over the convergence tolerance: the held force is O(fs) when
+  // a nonholonomic row is needed, round-off when not.
+  out.second_kind = out.holonomic_residual > std::max(tol, 1e-8) * fs;
+  out.reaction = m > 0 ? VecX(cd.A.transpose() * out.lambda) : VecX::Zero(nv);
+  out.force_residual = maxAbs(Q + out.reaction);
+  double g = 0;
+  for (int r = 0; r < m; ++r)
+    if (cd.holonomic[r]) g = std::max(g, std::abs(cd.gap[r]));
+  out.gap_residual = g;
+  out.motion_residual = maxAbs(cd.b) + maxAbs(cd.abias);
+  out.residual = std::max(out.force_residual / fs, out.gap_residual / ls);
+}
+
+std::string searchMessage(const EquilibriumResult& out, bool balanced_but_moving, int it,
+                          const std::string& stop) {
+  std::ostringstream msg;
+  msg.precision(3);
+  if (out.converged) {
+    msg << "converged in " << it << " iterations: scaled residual " << out.residual;
+  } else if (balanced_but_moving) {
+    msg << "no equilibrium: forces balance but the support moves here (|b| + |abias| = "
+        << out.motion_residual << "), so v = 0 is not admissible";
+  } else {
+    msg << "no equilibrium near the guess: smallest scaled residual " << out.residual
+        << " (force " << out.force_residual << ", gap " << out.gap_residual << ") after " << it
+        << " iterations; " << stop;
+  }
+  return msg.str();
+}
+
+/// Local dimension: directions δθ along which some δλ keeps F = 0 to first
+/// order, i.e. the null space of P ∂F/∂θ, P = 1 − U Uᵀ with U spanning range(∂F/∂λ).
+void localDimension(Residual& res, double fs, double ls, const EquilibriumOptions& opt, int nv,
+                    EquilibriumResult& out) {
+  MatX Jt;
+  if (!res.jacobianTheta(out.q, out.lambda, fs, ls, Jt)) return;
+  const int m = res.m();
+  MatX PJ = Jt;
+  if (m > 0) {
+    MatX Jl = MatX::Zero(res.ne(), m);
+    Jl.topRows(nv) = res.cd().A.transpose() / fs;
+    Eigen::JacobiSVD<MatX> svl(Jl, Eigen::ComputeThinU);
+    const VecX& s = svl.singularValues();
+    int r = 0;
+    while (r < s.size() && s[r] > 1e-10 * std::max(s[0], 1e-300)) ++r;
+    const MatX U = svl.matrixU().leftCols(r);
+    PJ -= U * (U.transpose() * Jt);
+  }
+  Eigen::JacobiSVD<MatX> sv(PJ, Eigen::ComputeFullV);
+  const VecX& s = sv.singularValues();
+  const double ref = std::max(Jt.norm(), 1e-300);
+  int rank = 0;
+  while (rank < s.size() && s[rank] > opt.rank_tolerance * ref) ++rank;
+  out.manifold_dimension = nv - rank;
+  out.tangent = sv.matrixV().rightCols(nv - rank);
+}
+
 }  // namespace
 
 EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& constraints,
                                   const VecX& q_guess, const EquilibriumOptions& opt) {
   validate(model, q_guess, opt);
   Residual res(model, constraints, opt);
-  const int nv = model.nv, m = res.m(), ne = res.ne(), nx = nv + m;
+  const int m = res.m();
   EquilibriumResult out;
   for (size_t k = 0; k < constraints.size(); ++k)
     for (int r = 0; r < constraints[k]->rows(); ++r)
@@ -136,168 +333,19 @@ EquilibriumResult findEquilibrium(const Model& model, const ConstraintList& cons
     if (!(fs > 0)) fs = 1.0;
   }
   const double ls = opt.length_scale, tol = opt.tolerance;
-
   // Start from the least-squares multipliers at the guess.
   VecX lambda = m > 0 ? VecX(Eigen::CompleteOrthogonalDecomposition<MatX>(res.cd().A.transpose()).solve(-Q))
                       : VecX();
   VecX F;
   res.residual(q, lambda, fs, ls, F);
-
-  MatX Jt, J(ne, nx), Js(ne, nx);
-  VecX D(nx), qn(model.nq), Fn, lam_n;
-  double mu = 0;
-  int it = 0, slow = 0;
-  std::string stop = "iteration limit reached";
-  for (; it < opt.max_iterations; ++it) {
-    if (maxAbs(F) <= tol) break;
-    if (!res.jacobianTheta(q, lambda, fs, ls, Jt)) {
-      stop = "a finite-difference probe hit singular geometry (" + res.lastSingular() + ")";
-      break;
-    }
-    res.at(q, Q);
-    J.leftCols(nv) = Jt;
-    J.rightCols(m).setZero();
-    J.topRightCorner(nv, m) = res.cd().A.transpose() / fs;
-    // Column scaling, floored: a column that is zero up to finite-difference
-    // noise (a direction along the equilibrium manifold, e.g. a cyclic
-    // coordinate) must not be blown up to unit size — the minimum-norm step
-    // would then move far along it to cancel noise.
-    double cmax = 0;
-    for (int c = 0; c < nx; ++c) cmax = std::max(cmax, J.col(c).norm());
-    for (int c = 0; c < nx; ++c) {
-      D[c] = std::max(J.col(c).norm(), 1e-3 * cmax);
-      if (!(D[c] > 0)) D[c] = 1.0;
-      Js.col(c) = J.col(c) / D[c];
-    }
-    const VecX grad = Js.transpose() * F;
-    if (grad.norm() <= 1e-13 * std::max(1.0, Js.norm()) * F.norm()) {
-      stop = "the residual is stationary (a local minimum of ‖F‖ that is not zero)";
-      break;
-    }
-    bool accepted = false;
-    const double scale2 = (Js.transpose() * Js).diagonal().maxCoeff();
-    for (int tries = 0; tries < 16 && !accepted; ++tries) {
-      VecX ds;
-      if (mu == 0) {
-        // Singular values below the finite-difference noise are rank
-        // deficiency, not directions to follow.
-        Eigen::CompleteOrthogonalDecomposition<MatX> cod(Js);
-        cod.setThreshold(1e-6);
-        ds = cod.solve(-F);
-      } else {
-        MatX Aug(ne + nx, nx);
-        Aug << Js, std::sqrt(mu) * MatX::Identity(nx, nx);
-        VecX rhs = VecX::Zero(ne + nx);
-        rhs.head(ne) = -F;
-        ds = Eigen::ColPivHouseholderQR<MatX>(Aug).solve(rhs);
-      }
-      const VecX dx = ds.cwiseQuotient(D);
-      retract(model, q, dx.head(nv), qn);
-      lam_n = lambda + dx.tail(m);
-      if (dx.allFinite() && res.residual(qn, lam_n, fs, ls, Fn) && Fn.norm() < F.norm()) {
-        accepted = true;
-        slow = Fn.norm() > 0.999 * F.norm() ? slow + 1 : 0;
-        q = qn;
-        lambda = lam_n;
-        F = Fn;
-        mu = mu < 1e-12 * scale2 ? 0.0 : mu / 10;
-      } else {
-        mu = mu == 0 ? 1e-6 * scale2 : mu * 10;
-      }
-    }
-    if (!accepted) {
-      stop = "no step reduces the residual (a local minimum of ‖F‖ that is not zero)";
-      break;
-    }
-    if (slow >= 30) {
-      stop = "the residual stopped decreasing";
-      break;
-    }
-  }
+  std::string stop;
+  const int it = Search(model, res, fs, ls).run(q, lambda, F, opt, stop);
   out.iterations = it;
-
-  // Final report at q: minimum-norm multipliers, residuals, rank, dimension.
-  res.at(q, Q);
-  const ConstraintData& cd = res.cd();
-  out.q = q;
-  out.generalized_force = Q;
-  if (m > 0) {
-    Eigen::CompleteOrthogonalDecomposition<MatX> cod(cd.A.transpose());
-    cod.setThreshold(1e-10);
-    out.lambda = cod.solve(-Q);
-    out.rank_A = static_cast<int>(cod.rank());
-  } else {
-    out.lambda = VecX();
-  }
-  out.redundant_rows = m - out.rank_A;
-  // First or second kind: can the holonomic rows alone hold Q?
-  {
-    std::vector<int> hrows;
-    for (int r = 0; r < m; ++r)
-      if (cd.holonomic[r]) hrows.push_back(r);
-    if (static_cast<int>(hrows.size()) == m) {
-      out.holonomic_residual = 0;  // no nonholonomic row: the first kind by definition
-    } else if (hrows.empty()) {
-      out.holonomic_residual = maxAbs(Q);
-    } else {
-      MatX Ah(nv, hrows.size());
-      for (std::size_t k = 0; k < hrows.size(); ++k) Ah.col(k) = cd.A.row(hrows[k]).transpose();
-      Eigen::CompleteOrthogonalDecomposition<MatX> cod(Ah);
-      cod.setThreshold(1e-10);
-      const VecX lh = cod.solve(-Q);
-      out.holonomic_residual = maxAbs(Q + Ah * lh);
-    }
-    // A margin over the convergence tolerance: the held force is O(fs) when
-    // a nonholonomic row is needed, round-off when not.
-    out.second_kind = out.holonomic_residual > std::max(tol, 1e-8) * fs;
-  }
-  out.reaction = m > 0 ? VecX(cd.A.transpose() * out.lambda) : VecX::Zero(nv);
-  out.force_residual = maxAbs(Q + out.reaction);
-  double g = 0;
-  for (int r = 0; r < m; ++r)
-    if (cd.holonomic[r]) g = std::max(g, std::abs(cd.gap[r]));
-  out.gap_residual = g;
-  out.motion_residual = maxAbs(cd.b) + maxAbs(cd.abias);
-  out.residual = std::max(out.force_residual / fs, out.gap_residual / ls);
+  reportAt(res, q, fs, ls, tol, model.nv, out);
   const bool moving = out.motion_residual > tol * ls;
   out.converged = out.residual <= tol && !moving;
-
-  std::ostringstream msg;
-  msg.precision(3);
-  if (out.converged) {
-    msg << "converged in " << it << " iterations: scaled residual " << out.residual;
-  } else if (out.residual <= tol && moving) {
-    msg << "no equilibrium: forces balance but the support moves here (|b| + |abias| = "
-        << out.motion_residual << "), so v = 0 is not admissible";
-  } else {
-    msg << "no equilibrium near the guess: smallest scaled residual " << out.residual
-        << " (force " << out.force_residual << ", gap " << out.gap_residual << ") after " << it
-        << " iterations; " << stop;
-  }
-  out.message = msg.str();
-
-  // Local dimension: directions δθ along which some δλ keeps F = 0 to first
-  // order, i.e. the null space of P ∂F/∂θ, P = 1 − U Uᵀ with U spanning range(∂F/∂λ).
-  if (res.jacobianTheta(q, out.lambda, fs, ls, Jt)) {
-    MatX PJ = Jt;
-    if (m > 0) {
-      MatX Jl = MatX::Zero(ne, m);
-      Jl.topRows(nv) = cd.A.transpose() / fs;
-      Eigen::JacobiSVD<MatX> svl(Jl, Eigen::ComputeThinU);
-      const VecX& s = svl.singularValues();
-      int r = 0;
-      while (r < s.size() && s[r] > 1e-10 * std::max(s[0], 1e-300)) ++r;
-      const MatX U = svl.matrixU().leftCols(r);
-      PJ -= U * (U.transpose() * Jt);
-    }
-    Eigen::JacobiSVD<MatX> sv(PJ, Eigen::ComputeFullV);
-    const VecX& s = sv.singularValues();
-    const double ref = std::max(Jt.norm(), 1e-300);
-    int rank = 0;
-    while (rank < s.size() && s[rank] > opt.rank_tolerance * ref) ++rank;
-    out.manifold_dimension = nv - rank;
-    out.tangent = sv.matrixV().rightCols(nv - rank);
-  }
+  out.message = searchMessage(out, moving && out.residual <= tol, it, stop);
+  localDimension(res, fs, ls, opt, model.nv, out);
   return out;
 }
 

@@ -70,11 +70,9 @@ class Flow {
   std::vector<int> holonomic_;
 };
 
-}  // namespace
-
-LinearizationResult linearize(const Model& model, const ConstraintList& constraints,
-                              ConstrainedSolver& solver, const VecX& q, const VecX& v,
-                              const LinearizationOptions& opt) {
+/// The arguments linearize() accepts; throws naming the one it refuses.
+/// Returns the per-velocity flag "cyclic".
+std::vector<char> validate(const Model& model, const VecX& q, const VecX& v, const LinearizationOptions& opt) {
   const int nv = model.nv;
   if (q.size() != model.nq || v.size() != nv)
     throw std::invalid_argument("linearize: q must have size nq = " + std::to_string(model.nq) +
@@ -92,7 +90,44 @@ LinearizationResult linearize(const Model& model, const ConstraintList& constrai
   }
   if (!(opt.fd_step > 0) || !(opt.rank_tolerance > 0))
     throw std::invalid_argument("linearize: fd_step and rank_tolerance must be positive");
+  return is_cyclic;
+}
 
+/// Tangent space of the reduced state x_r = (θ_retained, δv): the null space
+/// of ∂(g, A v + b)/∂x_r, by central differences in θ (step h) and A in v.
+/// Returns its basis Z (columns), of dimension n − rank.
+MatX tangentBasis(Flow& flow, const std::vector<int>& retained, const VecX& v, double h,
+                  double rank_tolerance) {
+  const int nr = static_cast<int>(retained.size()), nv = static_cast<int>(v.size()), n = nr + nv;
+  const VecX theta0 = VecX::Zero(nv);
+  const int nc = flow.nh() + flow.m();
+  MatX Jc = MatX::Zero(nc, n);
+  for (int i = 0; i < nr; ++i) {
+    VecX th = theta0;
+    th[retained[i]] = h;
+    const VecX cp = flow.constraints(th, v);
+    th[retained[i]] = -h;
+    const VecX cm = flow.constraints(th, v);
+    Jc.col(i) = (cp - cm) / (2 * h);
+  }
+  flow.constraints(theta0, v);
+  if (flow.m() > 0) Jc.bottomRightCorner(flow.m(), nv) = flow.A();
+  if (nc == 0) return MatX::Identity(n, n);
+  int rank = 0;
+  Eigen::JacobiSVD<MatX> svd(Jc, Eigen::ComputeFullV);
+  const VecX& s = svd.singularValues();
+  const double ref = s.size() ? s[0] : 0.0;
+  while (rank < s.size() && s[rank] > rank_tolerance * std::max(ref, 1e-300)) ++rank;
+  return svd.matrixV().rightCols(n - rank);
+}
+
+}  // namespace
+
+LinearizationResult linearize(const Model& model, const ConstraintList& constraints,
+                              ConstrainedSolver& solver, const VecX& q, const VecX& v,
+                              const LinearizationOptions& opt) {
+  const int nv = model.nv;
+  const std::vector<char> is_cyclic = validate(model, q, v, opt);
   LinearizationResult out;
   for (int k = 0; k < nv; ++k)
     if (!is_cyclic[k]) out.retained.push_back(k);
@@ -137,31 +172,8 @@ LinearizationResult linearize(const Model& model, const ConstraintList& constrai
         std::max(out.symmetry_residual, (reduce(fp - fm) / (2 * h)).lpNorm<Eigen::Infinity>());
   }
 
-  // Tangent space: null space of ∂(g, A v + b)/∂x_r.
-  const int nc = flow.nh() + flow.m();
-  MatX Jc = MatX::Zero(nc, n);
-  for (int i = 0; i < nr; ++i) {
-    VecX th = theta0;
-    th[out.retained[i]] = h;
-    const VecX cp = flow.constraints(th, v);
-    th[out.retained[i]] = -h;
-    const VecX cm = flow.constraints(th, v);
-    Jc.col(i) = (cp - cm) / (2 * h);
-  }
-  flow.constraints(theta0, v);
-  if (flow.m() > 0) Jc.bottomRightCorner(flow.m(), nv) = flow.A();
-  int rank = 0;
-  MatX Z;
-  if (nc > 0) {
-    Eigen::JacobiSVD<MatX> svd(Jc, Eigen::ComputeFullV);
-    const VecX& s = svd.singularValues();
-    const double ref = s.size() ? s[0] : 0.0;
-    while (rank < s.size() && s[rank] > opt.rank_tolerance * std::max(ref, 1e-300)) ++rank;
-    Z = svd.matrixV().rightCols(n - rank);
-  } else {
-    Z = MatX::Identity(n, n);
-  }
-  out.dimension = n - rank;
+  const MatX Z = tangentBasis(flow, out.retained, v, h, opt.rank_tolerance);
+  out.dimension = static_cast<int>(Z.cols());
   out.basis = Z;
 
   // L = Zᵀ ∂f_r Z by central differences along each basis vector.

@@ -80,6 +80,34 @@ void DormandPrince853::stageState(int s, double h, const VecX& q, const VecX& v)
   retractWithRate(model_, q, theta_, vs_, qs_, kth_[s]);
 }
 
+// Hairer's error norm of dop853.f: the 5th- and 3rd-order estimates
+// combined, err = h e₅ / √((e₅² + 0.01 e₃²) 2n) in the mixed scales of the
+// coordinates and the velocities.
+double DormandPrince853::errorNorm(double h, const VecX& v) {
+  err5_th_.setZero();
+  err5_v_.setZero();
+  err3_th_.setZero();
+  err3_v_.setZero();
+  for (int k = 0; k <= dop853::kStages; ++k) {
+    err5_th_ += dop853::E5[k] * kth_[k];
+    err5_v_ += dop853::E5[k] * kv_[k];
+    err3_th_ += dop853::E3[k] * kth_[k];
+    err3_v_ += dop853::E3[k] * kv_[k];
+  }
+  double e5 = 0, e3 = 0;
+  for (int i = 0; i < model_.nv; ++i) {
+    const double sq = opt_.atol + opt_.rtol * std::max(scale_q_[i], scale_q_[i] + std::abs(theta1_[i]));
+    const double sv = opt_.atol + opt_.rtol * std::max(std::abs(v[i]), std::abs(v1_[i]));
+    e5 += std::pow(err5_th_[i] / sq, 2) + std::pow(err5_v_[i] / sv, 2);
+    e3 += std::pow(err3_th_[i] / sq, 2) + std::pow(err3_v_[i] / sv, 2);
+  }
+  const double denom = e5 + 0.01 * e3;
+  // A NaN or infinite sum is no error control: reject (not err = 0).
+  return denom > 0 && std::isfinite(denom) ? h * e5 / std::sqrt(denom * 2.0 * model_.nv)
+         : denom == 0                        ? 0.0
+                                             : std::numeric_limits<double>::infinity();
+}
+
 StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) {
   StepResult r;
   dense_ = extra_ = false;
@@ -120,30 +148,7 @@ StepResult DormandPrince853::step(AccelerationField& f, double& t, VecX& q, VecX
       field_ok = f(t + h, q1_, v1_, kv_[dop853::kStages]) && kv_[dop853::kStages].allFinite() && q1_.allFinite();
       if (field_ok) readRates(f, rates_[dop853::kStages]);
     }
-    if (field_ok) {
-      err5_th_.setZero();
-      err5_v_.setZero();
-      err3_th_.setZero();
-      err3_v_.setZero();
-      for (int k = 0; k <= dop853::kStages; ++k) {
-        err5_th_ += dop853::E5[k] * kth_[k];
-        err5_v_ += dop853::E5[k] * kv_[k];
-        err3_th_ += dop853::E3[k] * kth_[k];
-        err3_v_ += dop853::E3[k] * kv_[k];
-      }
-      double e5 = 0, e3 = 0;
-      for (int i = 0; i < model_.nv; ++i) {
-        const double sq = opt_.atol + opt_.rtol * std::max(scale_q_[i], scale_q_[i] + std::abs(theta1_[i]));
-        const double sv = opt_.atol + opt_.rtol * std::max(std::abs(v[i]), std::abs(v1_[i]));
-        e5 += std::pow(err5_th_[i] / sq, 2) + std::pow(err5_v_[i] / sv, 2);
-        e3 += std::pow(err3_th_[i] / sq, 2) + std::pow(err3_v_[i] / sv, 2);
-      }
-      const double denom = e5 + 0.01 * e3;
-      // A NaN or infinite sum is no error control: reject (not err = 0).
-      err = denom > 0 && std::isfinite(denom) ? h * e5 / std::sqrt(denom * 2.0 * model_.nv)
-            : denom == 0                        ? 0.0
-                                                : std::numeric_limits<double>::infinity();
-    }
+    if (field_ok) err = errorNorm(h, v);
     if (field_ok && err <= 1.0) {
       q_start_ = q;  // kept for the dense output
       v_start_ = v;

@@ -93,6 +93,9 @@ class Leapfrog final : public Integrator {
 
  private:
   void dropOldestPair();
+  void mixAnderson(int k, double change, double previous, double scale);
+  bool projectedField(AccelerationField& f, double t, const VecX& q, const VecX& x, VecX& out);
+  bool endKick(AccelerationField& f, double& t, VecX& q, VecX& v, double h, StepResult& r);
   const Model& model_;
   IntegratorOptions opt_;
   static constexpr int kAndersonDepth = 4;
@@ -156,6 +159,7 @@ class DormandPrince853 final : public Integrator {
   bool denseOutput(double s, VecX& q, VecX& v) override;
 
  private:
+  double errorNorm(double h, const VecX& v);
   void stageState(int s, double h, const VecX& q, const VecX& v);
   const Model& model_;
   IntegratorOptions opt_;

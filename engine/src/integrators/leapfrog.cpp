@@ -78,6 +78,79 @@ void Leapfrog::dropOldestPair() {
   --depth_;
 }
 
+// Anderson mixing of depth ≤ kAndersonDepth: z⁺ = G − ΔG γ with γ the
+// least-squares fit of the residual by its recent differences ΔF (each pair
+// scaled to |ΔF| = 1, which leaves z⁺ alone and keeps the normal equations'
+// conditioning that of the directions). Mixing keeps Δ in the span of the
+// rows' impulses: it only combines such Δs.
+void Leapfrog::mixAnderson(int k, double change, double previous, double scale) {
+  // A mixing step that did not halve the residual: the history (carried
+  // from the last step, or spoiled by round-off) is stale — restart.
+  if (k > 0 && change > 0.5 * previous) depth_ = 0;
+  if (k > 0 && res_prev_.lpNorm<Eigen::Infinity>() > kPairFloor * scale) {
+    if (depth_ == kAndersonDepth) dropOldestPair();
+    const double norm = (res_ - res_prev_).norm();
+    if (norm > 0) {
+      dF_.col(depth_) = (res_ - res_prev_) / norm;
+      dG_.col(depth_) = (g_ - g_prev_) / norm;
+      ++depth_;
+    }
+  }
+  res_prev_ = res_;
+  g_prev_ = g_;
+  z_ = g_;
+  while (depth_ > 0) {
+    const SmallMat gram = dF_.leftCols(depth_).transpose() * dF_.leftCols(depth_);
+    const SmallVec rhs = dF_.leftCols(depth_).transpose() * res_;
+    const Eigen::LDLT<SmallMat> ldlt(gram);
+    const SmallVec gamma = ldlt.solve(rhs);
+    if (ldlt.info() == Eigen::Success && gamma.allFinite() && ldlt.rcond() > 1e-10) {
+      z_.noalias() -= dG_.leftCols(depth_) * gamma;
+      return;
+    }
+    dropOldestPair();  // nearly dependent differences
+  }
+}
+
+// F(q, x) = f(q, P_q x): f at the velocity's projection onto the rows at
+// q. With redundant rows (a box flat on the ground) f exists only on the
+// rows — off them their acceleration-level right sides disagree. Both
+// kicks discard f's constraint part anyway (Δ absorbs it, the end
+// projection removes it); what changes is that the velocity-dependent
+// forces are taken at P_q x, which differs from x by O(h): the method stays
+// consistent, and symmetric since F(q, −x) = F(q, x).
+bool Leapfrog::projectedField(AccelerationField& f, double t, const VecX& q, const VecX& x, VecX& out) {
+  if (!f.constrained()) return f(t, q, x, out);
+  xp_ = x;
+  return f.projectVelocity(t, q, xp_) && f(t, q, xp_, out);
+}
+
+// The drift to q⁺ = q ⊕ h v½ and the second kick v⁺ = v½ + ½h F(q⁺, v½);
+// the step's power integrals by the trapezoid over the two kicks' stages.
+bool Leapfrog::endKick(AccelerationField& f, double& t, VecX& q, VecX& v, double h, StepResult& r) {
+  StageRates start{}, end{};
+  vh_ = z_.head(model_.nv);
+  readRates(f, start);  // at (q, v½) of the last iterate
+  // A − B' for the next predictor (B' is a_end_ until it is overwritten below).
+  if (have_end_) a_shift_ = a_ - a_end_;
+  else a_shift_.setZero();
+  integrate(model_, q, vh_, h, q1_);
+  ++r.evaluations;
+  if (!q1_.allFinite() || !projectedField(f, t + h, q1_, vh_, a_end_) || !a_end_.allFinite()) {
+    have_end_ = false;
+    return false;
+  }
+  readRates(f, end);
+  have_end_ = true;
+  v = vh_ + (0.5 * h) * a_end_;
+  q = q1_;
+  t += h;
+  r.h_taken = r.h_next = h;
+  // The powers, by the same rule: the trapezoid over the two kicks' stages.
+  for (int i = 0; i < AccelerationField::kMaxRates; ++i) r.integrals[i] = 0.5 * h * (start[i] + end[i]);
+  return true;
+}
+
 StepResult Leapfrog::step(AccelerationField& f, double& t, VecX& q, VecX& v, double h) {
   StepResult r;
   auto failed = [&](const char* why) {
@@ -106,28 +179,15 @@ StepResult Leapfrog::step(AccelerationField& f, double& t, VecX& q, VecX& v, dou
   if (constrained) depth_ = 0;
   z_.head(n) = v + (0.5 * h) * a_;
   z_.tail(n).setZero();
-  StageRates start{}, end{};
   bool converged = false;
   double last_change = 0, first_change = 0;
   const char* diverged =
       "the leapfrog's implicit half-step did not converge (the step is too large for the "
       "velocity-dependent forces: ½h·|∂f/∂v| must stay below 1); use a smaller dt";
-  // F(q, x) = f(q, P_q x): f at the velocity's projection onto the rows at
-  // q. With redundant rows (a box flat on the ground) f exists only on the
-  // rows — off them their acceleration-level right sides disagree. Both
-  // kicks discard f's constraint part anyway (Δ absorbs it, the end
-  // projection removes it); what changes is that the velocity-dependent
-  // forces are taken at P_q x, which differs from x by O(h): the method stays
-  // consistent, and symmetric since F(q, −x) = F(q, x).
-  auto F = [&](double tt, const VecX& qq, const VecX& x, VecX& out) {
-    if (!constrained) return f(tt, qq, x, out);
-    xp_ = x;
-    return f.projectVelocity(tt, qq, xp_) && f(tt, qq, xp_, out);
-  };
   for (int k = 0; k < opt_.implicit_max_iterations && !converged; ++k) {
     ++r.evaluations;
     vh_ = z_.head(n);  // x
-    if (!F(t, q, vh_, a_) || !a_.allFinite())
+    if (!projectedField(f, t, q, vh_, a_) || !a_.allFinite())
       return failed(k > 0 && last_change > first_change ? diverged : nullptr);
     w_ = v + (0.5 * h) * a_;
     g_.head(n) = w_ + z_.tail(n);
@@ -152,58 +212,10 @@ StepResult Leapfrog::step(AccelerationField& f, double& t, VecX& q, VecX& v, dou
       z_.swap(g_);
       break;
     }
-    // Anderson mixing of depth ≤ kAndersonDepth: z⁺ = G − ΔG γ with γ the
-    // least-squares fit of the residual by its recent differences ΔF (each
-    // pair scaled to |ΔF| = 1, which leaves z⁺ alone and keeps the normal
-    // equations' conditioning that of the directions). Mixing keeps Δ in
-    // the span of the rows' impulses: it only combines such Δs.
-    // A mixing step that did not halve the residual: the history (carried
-    // from the last step, or spoiled by round-off) is stale — restart.
-    if (k > 0 && change > 0.5 * previous) depth_ = 0;
-    if (k > 0 && res_prev_.lpNorm<Eigen::Infinity>() > kPairFloor * scale) {
-      if (depth_ == kAndersonDepth) dropOldestPair();
-      const double norm = (res_ - res_prev_).norm();
-      if (norm > 0) {
-        dF_.col(depth_) = (res_ - res_prev_) / norm;
-        dG_.col(depth_) = (g_ - g_prev_) / norm;
-        ++depth_;
-      }
-    }
-    res_prev_ = res_;
-    g_prev_ = g_;
-    z_ = g_;
-    while (depth_ > 0) {
-      const SmallMat gram = dF_.leftCols(depth_).transpose() * dF_.leftCols(depth_);
-      const SmallVec rhs = dF_.leftCols(depth_).transpose() * res_;
-      const Eigen::LDLT<SmallMat> ldlt(gram);
-      const SmallVec gamma = ldlt.solve(rhs);
-      if (ldlt.info() == Eigen::Success && gamma.allFinite() && ldlt.rcond() > 1e-10) {
-        z_.noalias() -= dG_.leftCols(depth_) * gamma;
-        break;
-      }
-      dropOldestPair();  // nearly dependent differences
-    }
+    mixAnderson(k, change, previous, scale);
   }
   if (!converged) return failed(diverged);
-  vh_ = z_.head(n);
-  readRates(f, start);  // at (q, v½) of the last iterate
-  // A − B' for the next predictor (B' is a_end_ until it is overwritten below).
-  if (have_end_) a_shift_ = a_ - a_end_;
-  else a_shift_.setZero();
-  integrate(model_, q, vh_, h, q1_);
-  ++r.evaluations;
-  if (!q1_.allFinite() || !F(t + h, q1_, vh_, a_end_) || !a_end_.allFinite()) {
-    have_end_ = false;
-    return failed(nullptr);
-  }
-  readRates(f, end);
-  have_end_ = true;
-  v = vh_ + (0.5 * h) * a_end_;
-  q = q1_;
-  t += h;
-  r.h_taken = r.h_next = h;
-  // The powers, by the same rule: the trapezoid over the two kicks' stages.
-  for (int i = 0; i < AccelerationField::kMaxRates; ++i) r.integrals[i] = 0.5 * h * (start[i] + end[i]);
+  if (!endKick(f, t, q, v, h, r)) return failed(nullptr);
   return r;
 }
 

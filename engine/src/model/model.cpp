@@ -61,6 +61,45 @@ bool finite(const Eigen::MatrixBase<Derived>& m) {
   return m.allFinite();
 }
 
+/// A joint of the given type at coordinate offsets (idx_q, idx_v), its motion
+/// subspace S in the joint frame.
+Joint makeJoint(const std::string& name, JointType type, const Vec3& axis, const JointLimits& limits,
+                int idx_q, int idx_v) {
+  Joint j;
+  j.type = type;
+  j.nq = jointNq(type);
+  j.nv = jointNv(type);
+  j.idx_q = idx_q;
+  j.idx_v = idx_v;
+  j.limits = limits;
+  if (jointTypeInfo(type).has_axis) {
+    if (!finite(axis) || axis.norm() < 1e-12) fail(name, "joint axis is zero or not finite");
+    j.axis = axis.normalized();
+  }
+  j.S = Mat6X::Zero(6, j.nv);
+  switch (type) {
+    case JointType::Fixed: break;
+    case JointType::Revolute: case JointType::Continuous: j.S.col(0).head<3>() = j.axis; break;
+    case JointType::Prismatic: j.S.col(0).tail<3>() = j.axis; break;
+    case JointType::Planar: {
+      // A pair a user can guess (docs/engine.md): t₁ = the first of the
+      // joint frame's x, y axes not within 45° of the normal, projected
+      // into the plane; t₂ = axis × t₁. Axis z: (x, y); axis x: (y, z);
+      // axis y: (x, −z).
+      const Vec3 first = std::abs(j.axis.x()) < std::sqrt(0.5) ? Vec3::UnitX() : Vec3::UnitY();
+      j.t1 = (first - first.dot(j.axis) * j.axis).normalized();
+      j.t2 = j.axis.cross(j.t1);
+      j.S.col(0).tail<3>() = j.t1;
+      j.S.col(1).tail<3>() = j.t2;
+      j.S.col(2).head<3>() = j.axis;
+      break;
+    }
+    case JointType::Floating: j.S = Mat6::Identity(); break;
+    case JointType::Ball: j.S.topRows<3>() = Mat3::Identity(); break;
+  }
+  return j;
+}
+
 }  // namespace
 
 Model ModelBuilder::build(std::vector<std::string>* notes) const {
@@ -91,38 +130,7 @@ Model ModelBuilder::build(std::vector<std::string>* notes) const {
     if ((e.placement.R.transpose() * e.placement.R - Mat3::Identity()).norm() > 1e-9)
       fail(e.name, "joint placement rotation is not orthonormal");
 
-    Joint j;
-    j.type = e.type;
-    j.nq = jointNq(e.type);
-    j.nv = jointNv(e.type);
-    j.idx_q = m.nq;
-    j.idx_v = m.nv;
-    j.limits = e.limits;
-    if (jointTypeInfo(e.type).has_axis) {
-      if (!finite(e.axis) || e.axis.norm() < 1e-12) fail(e.name, "joint axis is zero or not finite");
-      j.axis = e.axis.normalized();
-    }
-    j.S = Mat6X::Zero(6, j.nv);
-    switch (e.type) {
-      case JointType::Fixed: break;
-      case JointType::Revolute: case JointType::Continuous: j.S.col(0).head<3>() = j.axis; break;
-      case JointType::Prismatic: j.S.col(0).tail<3>() = j.axis; break;
-      case JointType::Planar: {
-        // A pair a user can guess (docs/engine.md): t₁ = the first of the
-        // joint frame's x, y axes not within 45° of the normal, projected
-        // into the plane; t₂ = axis × t₁. Axis z: (x, y); axis x: (y, z);
-        // axis y: (x, −z).
-        const Vec3 first = std::abs(j.axis.x()) < std::sqrt(0.5) ? Vec3::UnitX() : Vec3::UnitY();
-        j.t1 = (first - first.dot(j.axis) * j.axis).normalized();
-        j.t2 = j.axis.cross(j.t1);
-        j.S.col(0).tail<3>() = j.t1;
-        j.S.col(1).tail<3>() = j.t2;
-        j.S.col(2).head<3>() = j.axis;
-        break;
-      }
-      case JointType::Floating: j.S = Mat6::Identity(); break;
-      case JointType::Ball: j.S.topRows<3>() = Mat3::Identity(); break;
-    }
+    const Joint j = makeJoint(e.name, e.type, e.axis, e.limits, m.nq, m.nv);
     m.nq += j.nq;
     m.nv += j.nv;
     m.parent.push_back(e.parent);

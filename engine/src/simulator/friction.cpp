@@ -50,66 +50,86 @@ void detail::slipDirection(const ConstraintData& cd, UnilateralRow& r, double fl
   else r.dir = r.dir_start;
 }
 
+// Marks the sliding contacts (u.sliding); true when one of them may slide
+// on its settled direction (friction_settled.cpp): its slip is small beside
+// the state's speeds.
+bool Simulator::Impl::markSliding(const VecX& v) {
+  auto& u = *uni_;
+  const double screen = options_.contacts.settle_time > 0 && !u.settle_off
+                            ? detail::kSettleScreen * v.lpNorm<Eigen::Infinity>()
+                            : -1.0;
+  bool settling = false;
+  u.sliding.clear();  // capacity reserved: no allocation
+  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+    UnilateralRow& r = u.rows[k];
+    if (r.released) continue;
+    r.settling = false;
+    if (!cdata_->isActive(r.c) || !cdata_->isSliding(r.c)) continue;
+    u.sliding.push_back(k);
+    if (r.nf > 0 && r.creep == 0 && cdata_->slide[r.c].slip.norm() <= screen) r.settling = settling = true;
+  }
+  return settling;
+}
+
+// Friction forces per unit normal load gⱼ (columns of u.G), from the rows'
+// covectors (world spatial forces on A and B), with data_ at
+// forwardKinematics(q, v).
+void Simulator::Impl::slidingFrictionColumns() {
+  auto& u = *uni_;
+  for (int j = 0; j < static_cast<int>(u.sliding.size()); ++j) {
+    UnilateralRow& r = u.rows[u.sliding[j]];
+    detail::slipDirection(*cdata_, r, 10 * options_.contacts.speed_tol);
+    const auto& sr = cdata_->slide[r.c];
+    const Vec3 f = -r.mu_k * r.dir;  // components along the friction rows (kinetic μ)
+    auto g = u.G.col(j);
+    g.setZero();
+    if (r.a >= 0) {
+      spatialJacobianWorld(model_, *data_, r.a, u.J);
+      g.noalias() += u.J.transpose() * (sr.Wa.transpose() * f);
+    }
+    if (r.b >= 0) {
+      spatialJacobianWorld(model_, *data_, r.b, u.J);
+      g.noalias() -= u.J.transpose() * (sr.Wb.transpose() * f);
+    }
+  }
+}
+
+// 1 − R, R the normal loads' responses to each contact's unit friction
+// force: one solve at τ (λₙ⁰ into u.lam0, the full result in out) and one
+// at τ + gⱼ per sliding contact.
+bool Simulator::Impl::slidingLoadResponses(const VecX& q, const VecX& v, const VecX& tau,
+                                           ConstrainedResult& out) {
+  auto& u = *uni_;
+  const int k = static_cast<int>(u.sliding.size());
+  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, SolveOutputs::All);
+  if (!out.ok) return false;
+  for (int i = 0; i < k; ++i) u.lam0[i] = out.lambda[u.rows[u.sliding[i]].global];
+  for (int j = 0; j < k; ++j) {
+    u.tau_f = tau + u.G.col(j);
+    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u.tau_f, u.unit, SolveOutputs::All);
+    if (!u.unit.ok) {
+      out.ok = false;
+      out.error = u.unit.error;
+      return false;
+    }
+    for (int i = 0; i < k; ++i)
+      u.R(i, j) = (i == j ? 1.0 : 0.0) - (u.unit.lambda[u.rows[u.sliding[i]].global] - u.lam0[i]);
+  }
+  return true;
+}
+
 bool Simulator::Impl::solveDynamics(double t, const VecX& q, const VecX& v, const VecX& tau,
                               ConstrainedResult& out, SolveOutputs outputs) {
   auto* u = uni_.get();
-  if (u) {
-    // Sliding contacts whose slip is small beside the state's speeds may
-    // slide on their settled directions (friction_settled.cpp).
-    const double screen = options_.contacts.settle_time > 0 && !u->settle_off
-                              ? detail::kSettleScreen * v.lpNorm<Eigen::Infinity>()
-                              : -1.0;
-    bool settling = false;
-    u->sliding.clear();  // capacity reserved: no allocation
-    for (int k = 0; k < static_cast<int>(u->rows.size()); ++k) {
-      UnilateralRow& r = u->rows[k];
-      if (r.released) continue;
-      r.settling = false;
-      if (!cdata_->isActive(r.c) || !cdata_->isSliding(r.c)) continue;
-      u->sliding.push_back(k);
-      if (r.nf > 0 && r.creep == 0 && cdata_->slide[r.c].slip.norm() <= screen)
-        r.settling = settling = true;
-    }
-    if (settling) return solveSettling(t, q, v, tau, out, outputs);
-  }
+  if (u && markSliding(v)) return solveSettling(t, q, v, tau, out, outputs);
   if (u) u->friction_power = 0;
   if (!u || u->sliding.empty()) {
     solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, outputs);
     return out.ok;
   }
   const int k = static_cast<int>(u->sliding.size());
-  // Friction forces per unit normal load, from the rows' covectors (world
-  // spatial forces on A and B), with data_ at forwardKinematics(q, v).
-  for (int j = 0; j < k; ++j) {
-    UnilateralRow& r = u->rows[u->sliding[j]];
-    detail::slipDirection(*cdata_, r, 10 * options_.contacts.speed_tol);
-    const auto& sr = cdata_->slide[r.c];
-    const Vec3 f = -r.mu_k * r.dir;  // components along the friction rows (kinetic μ)
-    auto g = u->G.col(j);
-    g.setZero();
-    if (r.a >= 0) {
-      spatialJacobianWorld(model_, *data_, r.a, u->J);
-      g.noalias() += u->J.transpose() * (sr.Wa.transpose() * f);
-    }
-    if (r.b >= 0) {
-      spatialJacobianWorld(model_, *data_, r.b, u->J);
-      g.noalias() -= u->J.transpose() * (sr.Wb.transpose() * f);
-    }
-  }
-  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, SolveOutputs::All);
-  if (!out.ok) return false;
-  for (int i = 0; i < k; ++i) u->lam0[i] = out.lambda[u->rows[u->sliding[i]].global];
-  for (int j = 0; j < k; ++j) {
-    u->tau_f = tau + u->G.col(j);
-    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u->tau_f, u->unit, SolveOutputs::All);
-    if (!u->unit.ok) {
-      out.ok = false;
-      out.error = u->unit.error;
-      return false;
-    }
-    for (int i = 0; i < k; ++i)
-      u->R(i, j) = (i == j ? 1.0 : 0.0) - (u->unit.lambda[u->rows[u->sliding[i]].global] - u->lam0[i]);
-  }
+  slidingFrictionColumns();
+  if (!slidingLoadResponses(q, v, tau, out)) return false;
   auto fail = [&](const char* why) {
     out.ok = false;
     out.error = std::string("sliding friction: ") + why + " at contacts";
@@ -139,15 +159,14 @@ bool Simulator::Impl::solveDynamics(double t, const VecX& q, const VecX& v, cons
   for (int j = 0; j < k; ++j) u->friction_power -= u->s[j] * u->G.col(j).dot(v);
   solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u->tau_f, out, outputs);
   if (!out.ok) return false;
-  if (outputs == SolveOutputs::All) {
-    // Report the friction force on the friction rows' multipliers: the
-    // force along each row's direction, as for a sticking contact.
-    for (int j = 0; j < k; ++j) {
-      const UnilateralRow& r = u->rows[u->sliding[j]];
-      const auto& sr = cdata_->slide[r.c];
-      for (int i = 0; i < sr.n; ++i)
-        out.lambda[cdata_->offset[r.c] + sr.row[i]] = -r.mu_k * u->s[j] * r.dir[i] * sr.scale[i];
-    }
+  if (outputs != SolveOutputs::All) return true;
+  // Report the friction force on the friction rows' multipliers: the force
+  // along each row's direction, as for a sticking contact.
+  for (int j = 0; j < k; ++j) {
+    const UnilateralRow& r = u->rows[u->sliding[j]];
+    const auto& sr = cdata_->slide[r.c];
+    for (int i = 0; i < sr.n; ++i)
+      out.lambda[cdata_->offset[r.c] + sr.row[i]] = -r.mu_k * u->s[j] * r.dir[i] * sr.scale[i];
   }
   return true;
 }

@@ -151,10 +151,57 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
 
 }  // namespace
 
+// One candidate's turn in the block Gauss–Seidel (the loads updated as it
+// sweeps): its force on the disk of radius μₖλₙ, at the settled direction's
+// minimizer while its slip is slow beside the disk's answer, or along its
+// slip (its force then known, still affine in its load). Returns the radius.
+double Simulator::Impl::settleCandidate(int j, int F) {
+  auto& u = *uni_;
+  auto& p = u.settle_problem;
+  const double floor = 10 * options_.contacts.speed_tol;
+  UnilateralRow& r = u.rows[u.settle[j]];
+  const int o0 = r.settle_force, n = r.nf;
+  const double radius = r.mu_k * std::max(0.0, p.loadAt(j, F));
+  const double slip = cdata_->slide[r.c].slip.norm();
+  Vec3 fj = Vec3::Zero();
+  if (slip < options_.contacts.settle_time * radius * u.swmax[j]) {
+    Mat3 H;
+    Vec3 c;
+    p.disk(o0, n, F, H, c);
+    // The stable settled direction on the slip's own side.
+    detail::slipDirection(*cdata_, r, floor);
+    if (!settledForce(H, c, n, radius, r.dir, fj)) fj.setZero();  // along its slip (below)
+  }
+  if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
+    detail::slipDirection(*cdata_, r, floor);
+    fj = -radius * r.dir;
+  }
+  p.f.segment(o0, n) = fj.head(n);
+  return radius;
+}
+
+// The settled candidates' directions from their forces, and their forces
+// reported on their friction rows' multipliers.
+void Simulator::Impl::recordSettledForces(ConstrainedResult& out, SolveOutputs outputs) {
+  auto& u = *uni_;
+  const auto& p = u.settle_problem;
+  for (int j = 0; j < static_cast<int>(u.settle.size()); ++j) {
+    UnilateralRow& r = u.rows[u.settle[j]];
+    const auto& sr = cdata_->slide[r.c];
+    const double fn = p.f.segment(r.settle_force, r.nf).norm();
+    if (fn > 0) {
+      r.dir.setZero();
+      r.dir.head(r.nf) = -p.f.segment(r.settle_force, r.nf) / fn;
+    }
+    if (outputs == SolveOutputs::All)
+      for (int i = 0; i < sr.n; ++i)
+        out.lambda[cdata_->offset[r.c] + sr.row[i]] = p.f[r.settle_force + i] * sr.scale[i];
+  }
+}
+
 bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
                               ConstrainedResult& out, SolveOutputs outputs) {
   auto& u = *uni_;
-  const double settle_time = options_.contacts.settle_time;
   u.settle.clear();  // capacity reserved: no allocation
   int F = 0;
   for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
@@ -192,28 +239,7 @@ bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, cons
   // sweeps. A candidate slow to settle, or whose minimizer is inside its
   // circle, slides along its slip (its force then known, still affine in
   // its load).
-  const double floor = 10 * options_.contacts.speed_tol;
-  const bool settled = p.gaussSeidel(K, F, 1000, [&](int j) {
-    UnilateralRow& r = u.rows[u.settle[j]];
-    const int o0 = r.settle_force, n = r.nf;
-    const double radius = r.mu_k * std::max(0.0, p.loadAt(j, F));
-    const double slip = cdata_->slide[r.c].slip.norm();
-    Vec3 fj = Vec3::Zero();
-    if (slip < settle_time * radius * u.swmax[j]) {
-      Mat3 H;
-      Vec3 c;
-      p.disk(o0, n, F, H, c);
-      // The stable settled direction on the slip's own side.
-      detail::slipDirection(*cdata_, r, floor);
-      if (!settledForce(H, c, n, radius, r.dir, fj)) fj.setZero();  // along its slip (below)
-    }
-    if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
-      detail::slipDirection(*cdata_, r, floor);
-      fj = -radius * r.dir;
-    }
-    p.f.segment(o0, n) = fj.head(n);
-    return radius;
-  });
+  const bool settled = p.gaussSeidel(K, F, 1000, [&](int j) { return settleCandidate(j, F); });
   if (!settled) {
     // Along their slips, as without this path (the loads still exact).
     ++counters_.settle_unsettled;
@@ -233,18 +259,7 @@ bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, cons
   double power = 0;
   for (int c = 0; c < F; ++c) power -= p.f[c] * p.U.col(c).dot(v);
   u.friction_power += power;  // beside the other sliding contacts'
-  for (int j = 0; j < K; ++j) {
-    UnilateralRow& r = u.rows[u.settle[j]];
-    const auto& sr = cdata_->slide[r.c];
-    const double fn = p.f.segment(r.settle_force, r.nf).norm();
-    if (fn > 0) {
-      r.dir.setZero();
-      r.dir.head(r.nf) = -p.f.segment(r.settle_force, r.nf) / fn;
-    }
-    if (outputs == SolveOutputs::All)
-      for (int i = 0; i < sr.n; ++i)
-        out.lambda[cdata_->offset[r.c] + sr.row[i]] = p.f[r.settle_force + i] * sr.scale[i];
-  }
+  recordSettledForces(out, outputs);
   restore();
   return true;
 }

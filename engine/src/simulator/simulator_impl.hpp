@@ -72,6 +72,11 @@ struct Simulator::Impl {
   bool frictionOnset(int forced, std::string& error);
   bool solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
                      ConstrainedResult& out, SolveOutputs outputs);
+  bool markSliding(const VecX& v);
+  void slidingFrictionColumns();
+  bool slidingLoadResponses(const VecX& q, const VecX& v, const VecX& tau, ConstrainedResult& out);
+  double settleCandidate(int j, int F);
+  void recordSettledForces(ConstrainedResult& out, SolveOutputs outputs);
   void frictionUnitForces(const std::vector<int>& rows, int detail::UnilateralRow::*first,
                           detail::FrictionProblem& p);
   bool frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,

@@ -302,11 +302,85 @@ bool splitGeneral(TreeWorkspace& ws, const Joint& j, bool root, Node& nd, Mat6& 
   return true;
 }
 
+/// Step 1 of the factor pass at body i: stack its own rows and the
+/// children's unresolved rows, compressing whenever the stack would exceed
+/// 12 rows and once at the end.
+void stackAndCompress(const Data& data, const ConstraintData& cdata, TreeWorkspace& ws, int i,
+                      const Joint& j) {
+  const SolverOptions& o = ws.options;
+  Node& nd = ws.nodes[i];
+  nd.ncomp = 0;
+  nd.nK = 0;
+  nd.nfree = 0;
+  nd.K.resize(0, 6);
+  int nb = 0;
+  Compression* cur = &nd.comp[0];
+  cur->nseg = 0;
+  auto compressStack = [&](bool last) {
+    bool soft = false;
+    for (int s = 0; s < cur->nseg; ++s) soft |= softSegment(ws, nd, nd.ncomp, cur->seg[s]);
+    // One segment: a constraint's own rows, or one child's handed-up rows
+    // (independent as handed up) — where redundancy is rare and the
+    // certificate pays. Several segments meeting is where it arises (an
+    // axle's normal row and its trailer's, both on the ground): straight to
+    // the QR, with no certificate attempted.
+    const bool whole = o.certify_independent_stacks && last && nd.ncomp == 0 &&
+                       cur->nseg == 1 && !soft && j.type != JointType::Floating;
+    compress(o, *cur, nb, nd.K, whole, ws.certified_stacks);
+    nd.nK = cur->rank;
+    cur->soft = false;
+    // Dropped rows with no compliance: redundant, their multipliers free.
+    cur->nfree = soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
+    nd.nfree += cur->nfree;
+    // The next stack, if any group is left to start one (the constructor
+    // sized comp for the most compressions the groups can cause).
+    ++nd.ncomp;
+    cur = nd.ncomp < static_cast<int>(nd.comp.size()) ? &nd.comp[nd.ncomp] : nullptr;
+    if (cur) cur->nseg = 0;
+  };
+  for (const Segment& g : nd.groups) {
+    const int r = g.kind == Segment::Block ? ws.blocks[g.id].rows : ws.nodes[g.id].npass;
+    if (r == 0) continue;
+    if (nb + r > 12) {  // compress, and carry the kept rows on
+      compressStack(false);
+      nb = nd.nK;
+      if (nb > 0) {
+        stackRows(cur->f, 0, nd.K);
+        cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
+      }
+    }
+    if (g.kind == Segment::Block)
+      stackBodyRows(data, cdata, ws.blocks[g.id], cur->f, nb);
+    else
+      stackChildRows(data.liMi[g.id], ws.nodes[g.id].Kpass, cur->f, nb);
+    cur->seg[cur->nseg++] = {g.kind, g.id, r};
+    nb += r;
+  }
+  if (cur && cur->nseg > 0) compressStack(true);
+}
+
+/// Closed joint-space rows on body i's joint lock it (tree_solver/locked.cpp);
+/// one row fixes q̈, the others are redundant, split by min norm.
+void lockByJointRows(const ConstraintData& cdata, TreeWorkspace& ws, Node& nd) {
+  nd.locked = false;
+  if (nd.jrows.empty()) return;
+  nd.c2 = 0;
+  int closed = 0;
+  for (JointRow& r : nd.jrows) {
+    r.active = cdata.isActive(r.constraint);
+    r.c = r.active ? cdata.blocks[r.constraint].A_joint(r.row, 0) : 0.0;
+    r.active = r.active && r.c != 0;  // a zero row locks nothing (λ = 0)
+    nd.c2 += r.c * r.c;
+    closed += r.active ? 1 : 0;
+  }
+  nd.locked = closed > 0;
+  if (closed > 1) ws.redundant += closed - 1;
+}
+
 }  // namespace
 
 void factorPass(const Model& model, const Data& data, const ConstraintData& cdata,
                 TreeWorkspace& ws) {
-  const SolverOptions& o = ws.options;
   for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].IA = model.spatial_inertia[i];
   ws.redundant = 0;
   ws.nseeds = 0;
@@ -317,57 +391,7 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     Node& nd = ws.nodes[i];
     const Joint& j = model.joints[i];
     const int p = model.parent[i];
-
-    // 1. Stack own rows and the children's unresolved rows, compressing
-    //    whenever the stack would exceed 12 rows and once at the end.
-    nd.ncomp = 0;
-    nd.nK = 0;
-    nd.nfree = 0;
-    nd.K.resize(0, 6);
-    int nb = 0;
-    Compression* cur = &nd.comp[0];
-    cur->nseg = 0;
-    auto compressStack = [&](bool last) {
-      bool soft = false;
-      for (int s = 0; s < cur->nseg; ++s) soft |= softSegment(ws, nd, nd.ncomp, cur->seg[s]);
-      // One segment: a constraint's own rows, or one child's handed-up rows
-      // (independent as handed up) — where redundancy is rare and the
-      // certificate pays. Several segments meeting is where it arises (an
-      // axle's normal row and its trailer's, both on the ground): straight to
-      // the QR, with no certificate attempted.
-      const bool whole = o.certify_independent_stacks && last && nd.ncomp == 0 &&
-                         cur->nseg == 1 && !soft && j.type != JointType::Floating;
-      compress(o, *cur, nb, nd.K, whole, ws.certified_stacks);
-      nd.nK = cur->rank;
-      cur->soft = false;
-      // Dropped rows with no compliance: redundant, their multipliers free.
-      cur->nfree = soft ? softCompress(ws, i, nd.ncomp) : nb - cur->rank;
-      nd.nfree += cur->nfree;
-      // The next stack, if any group is left to start one (the constructor
-      // sized comp for the most compressions the groups can cause).
-      ++nd.ncomp;
-      cur = nd.ncomp < static_cast<int>(nd.comp.size()) ? &nd.comp[nd.ncomp] : nullptr;
-      if (cur) cur->nseg = 0;
-    };
-    for (const Segment& g : nd.groups) {
-      const int r = g.kind == Segment::Block ? ws.blocks[g.id].rows : ws.nodes[g.id].npass;
-      if (r == 0) continue;
-      if (nb + r > 12) {  // compress, and carry the kept rows on
-        compressStack(false);
-        nb = nd.nK;
-        if (nb > 0) {
-          stackRows(cur->f, 0, nd.K);
-          cur->seg[cur->nseg++] = {Segment::Previous, -1, nb};
-        }
-      }
-      if (g.kind == Segment::Block)
-        stackBodyRows(data, cdata, ws.blocks[g.id], cur->f, nb);
-      else
-        stackChildRows(data.liMi[g.id], ws.nodes[g.id].Kpass, cur->f, nb);
-      cur->seg[cur->nseg++] = {g.kind, g.id, r};
-      nb += r;
-    }
-    if (cur && cur->nseg > 0) compressStack(true);
+    stackAndCompress(data, cdata, ws, i, j);
 
     // 2. Split the joint: G = K S = U Σ Vᵀ; rows along U₁ fix V₁ᵀ q̈, rows
     //    along U₂ do not involve q̈ and go to the parent; V₂ spans the free part.
@@ -377,26 +401,12 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
     Mat6& H = nd.H;
     nd.soft = false;
     nd.softpass = false;
-    // Closed joint-space rows on this joint lock it (tree_solver/locked.cpp).
-    nd.locked = false;
-    if (!nd.jrows.empty()) {
-      nd.c2 = 0;
-      int closed = 0;
-      for (JointRow& r : nd.jrows) {
-        r.active = cdata.isActive(r.constraint);
-        r.c = r.active ? cdata.blocks[r.constraint].A_joint(r.row, 0) : 0.0;
-        r.active = r.active && r.c != 0;  // a zero row locks nothing (λ = 0)
-        nd.c2 += r.c * r.c;
-        closed += r.active ? 1 : 0;
-      }
-      nd.locked = closed > 0;
-      if (closed > 1) ws.redundant += closed - 1;  // one row on q̈, split by min norm
-    }
+    lockByJointRows(cdata, ws, nd);
     const bool soft_rows = nd.ncomp > 0 && nd.comp[nd.ncomp - 1].soft;
     nd.dinv_factor = false;
     if (nd.locked)
       splitLocked(ws, j, p < 0, nd, H);
-    else if (soft_rows || !(j.nv == 1 ? splitOneDof(o, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))
+    else if (soft_rows || !(j.nv == 1 ? splitOneDof(ws.options, j, p < 0, nd, H) : splitGeneral(ws, j, p < 0, nd, H)))
       splitSoft(ws, j, p < 0, nd, H);
     if (p < 0) nd.nfree += nd.npass;  // rows no joint can move: their combinations are zero rows of A
     if (nd.nfree > 0) {  // tree_solver/min_norm.cpp starts from these bodies
@@ -408,58 +418,6 @@ void factorPass(const Model& model, const Data& data, const ConstraintData& cdat
   }
 }
 
-void factorPassIfChanged(const Model& model, const Data& data, const ConstraintData& cdata,
-                         const VecX& q, TreeWorkspace& ws) {
-  FactorRecord& rec = ws.factor_record;
-  int n = 0;
-  for (const TreeBlock& tb : ws.blocks) {
-    rec.next[n++] = tb.rows;
-    const RowBlock& blk = cdata.blocks[tb.constraint];
-    const RowMatrix6& W = tb.sign > 0 ? blk.Wa : blk.Wb;
-    for (int r = 0; r < tb.rows; ++r)
-      for (int c = 0; c < 6; ++c) rec.next[n++] = W(r, c);
-  }
-  for (int b : ws.jrow_nodes)
-    for (const JointRow& jr : ws.nodes[b].jrows) {
-      const bool active = cdata.isActive(jr.constraint);
-      rec.next[n++] = active ? 1.0 : 0.0;
-      rec.next[n++] = active ? cdata.blocks[jr.constraint].A_joint(jr.row, 0) : 0.0;
-    }
-  const int tree_length = n;
-  const int capacity = static_cast<int>(rec.next.size());
-  bool fits = true;  // a joint-space row's columns are sized by its ConstraintData
-  for (const LoopRow& lr : ws.loops) {
-    const RowBlock& blk = cdata.blocks[lr.constraint];
-    if (lr.joint_space) {
-      const int cols = static_cast<int>(blk.joint_cols.size());
-      fits = fits && n + 1 + cols <= capacity;
-      if (!fits) break;
-      rec.next[n++] = cols;
-      for (int c = 0; c < cols; ++c) rec.next[n++] = blk.A_joint(lr.row, c);
-    } else {
-      for (int c = 0; c < 6; ++c) rec.next[n++] = blk.Wa(lr.row, c);
-      for (int c = 0; c < 6; ++c) rec.next[n++] = blk.Wb(lr.row, c);
-    }
-  }
-  auto equal = [&](int from, int to) {
-    return std::equal(rec.next.begin() + from, rec.next.begin() + to, rec.rows.begin() + from);
-  };
-  const bool tree_same = rec.valid && tree_length == rec.tree_length && rec.q == q &&
-                         equal(0, tree_length);
-  const bool loops_same = tree_same && fits && n == rec.length && equal(tree_length, n);
-  ws.last_factor_reused = tree_same;
-  if (!loops_same) ws.loop_closure_valid = false;
-  if (!tree_same) factorPass(model, data, cdata, ws);
-  else ws.redundant = rec.redundant;  // what factorPass set; the callers add to it
-  if (loops_same) return;
-  std::swap(rec.rows, rec.next);  // same capacity: no allocation
-  rec.tree_length = tree_length;
-  rec.length = n;
-  rec.q = q;
-  rec.redundant = ws.redundant;
-  rec.valid = fits;
-}
-
 void velocityCouplings(const Model& model, TreeWorkspace& ws) {
   for (int i = 0; i < model.nbodies; ++i) {
     Node& nd = ws.nodes[i];
@@ -468,8 +426,94 @@ void velocityCouplings(const Model& model, TreeWorkspace& ws) {
   }
 }
 
+namespace {
+
+/// Body i's right sides through its recorded compressions, Qᵀ E r, into each
+/// compression's rhs and the body's k. With check, false (and ws.failure
+/// set) when a dropped row's right side is not the combination of the kept
+/// ones its row is: no acceleration satisfies them.
+bool compressedRhs(TreeWorkspace& ws, int i, bool check) {
+  Node& nd = ws.nodes[i];
+  for (int e = 0; e < nd.ncomp; ++e) {
+    Compression& cp = nd.comp[e];
+    BufVec r;
+    gatherRhs(ws, i, e, r);
+    double rmax = 0;  // ‖E r‖∞, the scale of the consistency test
+    for (int k = 0; k < cp.nrows; ++k) {
+      r[k] *= cp.E[k];
+      rmax = std::max(rmax, std::abs(r[k]));
+    }
+    applyQt(cp, r);
+    const double tol = ws.options.consistency_tol * std::max(1.0, rmax);
+    double res = 0;
+    if (cp.soft) {
+      if (!softCompressionRhs(cp, r, tol, res) && check) {
+        ws.failure = {true, i, e, res};
+        return false;
+      }
+      continue;
+    }
+    cp.rhs.resize(cp.rank);
+    for (int k = 0; k < cp.rank; ++k) cp.rhs[k] = r[k];
+    if (!check) continue;
+    for (int k = cp.rank; k < cp.nrows; ++k) res = std::max(res, std::abs(r[k]));
+    if (res > tol) {
+      ws.failure = {true, i, e, res};
+      return false;
+    }
+  }
+  if (nd.ncomp > 0)
+    nd.k = nd.comp[nd.ncomp - 1].rhs;
+  else
+    nd.k.resize(0);
+  return true;
+}
+
+/// The bias force a rigid joint's body hands its parent — the gradient of
+/// the child's cost-to-go in ā = X a_p + c:
+///   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ,   d = S G⁺ k,
+/// with Pᵀ x = x − GKᵀ(Sᵀ x) and Kᵀ G⁺ᵀ = GKᵀ:  H ā + x − GKᵀ(Sᵀx − τ).
+Vec6 parentBias(const TreeWorkspace& ws, const Node& nd, const Joint& j) {
+  const auto tau = ws.tau.segment(j.idx_v, j.nv);
+  Vec6 pa = nd.pA;
+  if (nd.nf > 0) pa.noalias() += nd.U * (nd.Dinv * nd.u);
+  Vec6 g = ws.use_c ? nd.Hc : Vec6::Zero();
+  if (nd.rankG > 0 && j.nv == 1) {
+    pa += nd.gp.dot(nd.k) * nd.ias;
+    g -= (j.S.col(0).dot(pa) - tau[0]) * nd.gk;
+  } else if (nd.rankG > 0) {
+    KVec y(j.nv);
+    y.noalias() = nd.Gpinv * nd.k;
+    pa.noalias() += nd.IaS * y;
+    KVec sx(j.nv);
+    sx.noalias() = j.S.transpose() * pa;
+    sx -= tau;
+    g.noalias() -= nd.GK.transpose() * sx;
+  }
+  g += pa;
+  if (nd.locked) g += nd.rho * nd.Hs;  // a = ā + s ρ: ρ enters as c does
+  return g;
+}
+
+/// A body with compliant rows (tree_solver/soft.cpp): its bias to the parent
+/// and the right sides it hands up.
+void softBodyBias(const Data& data, TreeWorkspace& ws, int i, const Joint& j, int p) {
+  Node& nd = ws.nodes[i];
+  Vec6 pa;
+  softBias(nd.locked ? lockedJoint() : j, nd, ws.tau, pa);
+  if (p >= 0) {
+    if (ws.use_c) pa += nd.Hc;
+    if (nd.locked) pa += nd.rho * nd.Hs;  // a = ā + s ρ: ρ enters as c does
+    ws.nodes[p].pA += data.liMi[i].actForce(pa);
+  }
+  nd.kpass = nd.kv.head(nd.npass);
+  if (ws.use_c && nd.npass > 0) nd.kpass -= nd.kpc;
+  if (nd.locked && nd.npass > 0) nd.kpass -= nd.rho * nd.kps;
+}
+
+}  // namespace
+
 bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool check) {
-  const SolverOptions& o = ws.options;
   for (int i = 0; i < model.nbodies; ++i) ws.nodes[i].pA = ws.nodes[i].bias0;
   ws.failure = {};
 
@@ -478,89 +522,20 @@ bool biasPass(const Model& model, const Data& data, TreeWorkspace& ws, bool chec
     const Joint& j = model.joints[i];
     const int p = model.parent[i];
     if (nd.locked && !lockedRhs(ws, i, check) && check) return false;
-
-    // Right sides through the recorded compressions: Qᵀ E r.
-    for (int e = 0; e < nd.ncomp; ++e) {
-      Compression& cp = nd.comp[e];
-      BufVec r;
-      gatherRhs(ws, i, e, r);
-      double rmax = 0;  // ‖E r‖∞, the scale of the consistency test
-      for (int k = 0; k < cp.nrows; ++k) {
-        r[k] *= cp.E[k];
-        rmax = std::max(rmax, std::abs(r[k]));
-      }
-      applyQt(cp, r);
-      const double tol = o.consistency_tol * std::max(1.0, rmax);
-      if (cp.soft) {
-        double res;
-        if (!softCompressionRhs(cp, r, tol, res) && check) {
-          ws.failure = {true, i, e, res};
-          return false;
-        }
-        continue;
-      }
-      cp.rhs.resize(cp.rank);
-      for (int k = 0; k < cp.rank; ++k) cp.rhs[k] = r[k];
-      if (check && cp.nrows > cp.rank) {
-        // The dropped rows are combinations of the kept ones: their right
-        // sides must be the same combinations, or no acceleration satisfies them.
-        double res = 0;
-        for (int k = cp.rank; k < cp.nrows; ++k) res = std::max(res, std::abs(r[k]));
-        if (res > tol) {
-          ws.failure = {true, i, e, res};
-          return false;
-        }
-      }
-    }
-    if (nd.ncomp > 0)
-      nd.k = nd.comp[nd.ncomp - 1].rhs;
-    else
-      nd.k.resize(0);
-
+    if (!compressedRhs(ws, i, check)) return false;
     if (nd.soft) {
-      Vec6 pa;
-      softBias(nd.locked ? lockedJoint() : j, nd, ws.tau, pa);
-      if (p >= 0) {
-        if (ws.use_c) pa += nd.Hc;
-        if (nd.locked) pa += nd.rho * nd.Hs;  // a = ā + s ρ: ρ enters as c does
-        ws.nodes[p].pA += data.liMi[i].actForce(pa);
-      }
-      nd.kpass = nd.kv.head(nd.npass);
-      if (ws.use_c && nd.npass > 0) nd.kpass -= nd.kpc;
-      if (nd.locked && nd.npass > 0) nd.kpass -= nd.rho * nd.kps;
+      softBodyBias(data, ws, i, j, p);
       continue;
     }
-    const auto tau = ws.tau.segment(j.idx_v, j.nv);
     if (nd.nf > 0) {
+      const auto tau = ws.tau.segment(j.idx_v, j.nv);
       if (nd.rankG > 0)
         nd.u.noalias() = nd.V2.transpose() * tau;
       else
         nd.u = tau;
       nd.u.noalias() -= nd.S2.transpose() * nd.pA;
     }
-    if (p >= 0) {
-      Vec6 pa = nd.pA;
-      if (nd.nf > 0) pa.noalias() += nd.U * (nd.Dinv * nd.u);
-      // Gradient of the child's cost-to-go in ā = X a_p + c:
-      //   H ā + Pᵀ(Ia d + pa) + Kᵀ G⁺ᵀ τ,   d = S G⁺ k,
-      // with Pᵀ x = x − GKᵀ(Sᵀ x) and Kᵀ G⁺ᵀ = GKᵀ:  H ā + x − GKᵀ(Sᵀx − τ).
-      Vec6 g = ws.use_c ? nd.Hc : Vec6::Zero();
-      if (nd.rankG > 0 && j.nv == 1) {
-        pa += nd.gp.dot(nd.k) * nd.ias;
-        g -= (j.S.col(0).dot(pa) - tau[0]) * nd.gk;
-      } else if (nd.rankG > 0) {
-        KVec y(j.nv);
-        y.noalias() = nd.Gpinv * nd.k;
-        pa.noalias() += nd.IaS * y;
-        KVec sx(j.nv);
-        sx.noalias() = j.S.transpose() * pa;
-        sx -= tau;
-        g.noalias() -= nd.GK.transpose() * sx;
-      }
-      g += pa;
-      if (nd.locked) g += nd.rho * nd.Hs;  // a = ā + s ρ: ρ enters as c does
-      ws.nodes[p].pA += data.liMi[i].actForce(g);
-    }
+    if (p >= 0) ws.nodes[p].pA += data.liMi[i].actForce(parentBias(ws, nd, j));
     if (nd.npass > 0) {
       applyU2t(nd, nd.k, nd.kpass);
       if (ws.use_c) nd.kpass -= nd.kpc;

@@ -116,6 +116,131 @@ int keptCount(const Node& nd, const Compression& cp, Kept kept) {
   return kept == Kept::Mu ? cp.rank : kept == Kept::Nu ? nd.npass : 0;
 }
 
+/// The columns of the hard rows' least-squares system (D = 0, Z = the
+/// dropped coordinates): G = W E Q, Q applied from the right to the rows of
+/// the block-diagonal W E. Its dropped columns are the t columns, its kept
+/// columns G₁ the δμ ones (G₁ U₂ the δν ones).
+void hardColumns(const TreeWorkspace& ws, const Node& nd, int e, const Compression& cp, Kept kept, LsSystem& F) {
+  const int r = cp.rank, z = cp.nfree, nb = cp.nrows, nk = keptCount(nd, cp, kept);
+  double G[12][12];
+  int at = 0;
+  for (int s = 0; s < cp.nseg; ++s) {
+    const Segment& g = cp.seg[s];
+    const SmallMat* W = segmentWeight(ws, nd, e, g);
+    for (int a = 0; a < g.rows; ++a) {
+      double* row = G[at + a];
+      for (int b = 0; b < nb; ++b) row[b] = 0;
+      if (!W) {
+        row[at + a] = cp.E[at + a];
+        continue;
+      }
+      for (int b = a; b < g.rows; ++b) row[at + b] = (*W)(a, b) * cp.E[at + b];
+    }
+    at += g.rows;
+  }
+  for (int k = 0; k < cp.f.rank; ++k) {  // G ← G H_k, H_k = 1 − τ v vᵀ, v = [0…0, 1, essential]
+    const double tau = cp.f.tau[k];
+    const int pk = cp.f.perm[k];
+    double v[12];
+    for (int b = k + 1; b < nb; ++b) v[b] = cp.f.a[b][pk];
+    for (int a = 0; a < nb; ++a) {
+      double* row = G[a];
+      double d = row[k];
+      for (int b = k + 1; b < nb; ++b) d += row[b] * v[b];
+      if (d == 0) continue;
+      d *= tau;
+      row[k] -= d;
+      for (int b = k + 1; b < nb; ++b) row[b] -= d * v[b];
+    }
+  }
+  for (int a = 0; a < nb; ++a)
+    for (int c = 0; c < z; ++c) F.col[c][a] = G[a][r + c];
+  if (kept == Kept::Mu) {
+    for (int a = 0; a < nb; ++a)
+      for (int c = 0; c < r; ++c) F.col[z + c][a] = G[a][c];
+  } else if (kept == Kept::Nu) {
+    switch (nd.u2form) {
+      case U2Form::Identity:
+        for (int a = 0; a < nb; ++a)
+          for (int c = 0; c < nk; ++c) F.col[z + c][a] = G[a][c];
+        break;
+      case U2Form::Reflector:  // U₂ = columns 1… of 1 − β u uᵀ
+        for (int a = 0; a < nb; ++a) {
+          double gu = 0;
+          for (int c = 0; c < r; ++c) gu += G[a][c] * nd.hu[c];
+          gu *= nd.hbeta;
+          for (int c = 0; c < nk; ++c) F.col[z + c][a] = G[a][c + 1] - gu * nd.hu[c + 1];
+        }
+        break;
+      case U2Form::Explicit:
+        for (int a = 0; a < nb; ++a)
+          for (int c = 0; c < nk; ++c) {
+            double v = 0;
+            for (int b = 0; b < r; ++b) v += G[a][b] * nd.U2(b, c);
+            F.col[z + c][a] = v;
+          }
+        break;
+    }
+  }
+}
+
+/// The columns of compliant rows: the stacked multipliers of each unit
+/// unknown, weighted segment by segment.
+void softColumns(const TreeWorkspace& ws, const Node& nd, int e, const Compression& cp, Kept kept, LsSystem& F) {
+  const int r = cp.rank, z = cp.nfree, nk = keptCount(nd, cp, kept);
+  BufVec y;
+  KVec dmu(r), unit(nk);
+  BufVec t(z);
+  for (int c = 0; c < z + nk; ++c) {
+    dmu.setZero();
+    t.setZero();
+    if (c < z) {
+      t[c] = 1;
+    } else if (kept == Kept::Mu) {
+      dmu[c - z] = 1;
+    } else {
+      unit.setZero();
+      unit[c - z] = 1;
+      addU2(nd, unit, dmu);
+    }
+    stacked(cp, dmu, t, y);
+    int at = 0;
+    for (int s = 0; s < cp.nseg; ++s) {
+      const Segment& g = cp.seg[s];
+      const SmallMat* W = segmentWeight(ws, nd, e, g);
+      for (int a = 0; a < g.rows; ++a) {
+        double v = W ? 0.0 : y[at + a];
+        if (W)
+          for (int b = a; b < g.rows; ++b) v += (*W)(a, b) * y[at + b];
+        F.col[c][at + a] = v;
+      }
+      at += g.rows;
+    }
+  }
+}
+
+/// A locked joint's rows (tree_solver/locked.cpp) as one more row of the
+/// system: their force ℓ moves with the kept multipliers, δℓ = −(K s)ᵀ δμ,
+/// δμ = U₂ δν, and their λ = c ℓ / Σc² costs (ℓ + δℓ)² / Σc².
+void lockedJointRow(const Node& nd, int z, int nk, const VecX& lambda, LsSystem& F) {
+  const int nb = F.rows, nvar = z + nk;
+  const double w = 1.0 / std::sqrt(nd.c2);
+  for (int c = 0; c < z; ++c) F.col[c][nb] = 0;
+  KVec unit(nk), dmu(nd.nK);
+  for (int c = 0; c < nk; ++c) {
+    unit.setZero();
+    unit[c] = 1;
+    dmu.setZero();
+    addU2(nd, unit, dmu);
+    F.col[z + c][nb] = -w * nd.gl.dot(dmu);
+  }
+  double ell = 0;
+  for (const JointRow& jr : nd.jrows)
+    if (jr.active) ell += jr.c * lambda[jr.global];
+  F.col[nvar][nb] = w * ell;
+  F.rows = nb + 1;
+}
+
 /// Leaves to root at compression e of body i: the least-squares system of
 /// its stack in [t; kept unknowns] — the stacked multipliers E Q [δμ; D δμ +
 /// Z t], each segment weighted by its cost-to-go, against the right side ρ —
@@ -124,106 +249,15 @@ int keptCount(const Node& nd, const Compression& cp, Kept kept) {
 void costOfCompression(TreeWorkspace& ws, int i, int e, Kept kept, const VecX& lambda) {
   Node& nd = ws.nodes[i];
   Compression& cp = nd.comp[e];
-  const int r = cp.rank, z = cp.nfree, nb = cp.nrows, nk = keptCount(nd, cp, kept);
+  const int z = cp.nfree, nk = keptCount(nd, cp, kept);
   const int nvar = z + nk;
   LsSystem& F = ws.mnF;
-  F.rows = nb;
+  F.rows = cp.nrows;
   F.cols = nvar + 1;
-  if (!cp.soft) {
-    // Hard rows (D = 0, Z = the dropped coordinates): G = W E Q, Q applied
-    // from the right to the rows of the block-diagonal W E. Its dropped
-    // columns are the t columns, its kept columns G₁ the δμ ones (G₁ U₂ the δν ones).
-    double G[12][12];
-    int at = 0;
-    for (int s = 0; s < cp.nseg; ++s) {
-      const Segment& g = cp.seg[s];
-      const SmallMat* W = segmentWeight(ws, nd, e, g);
-      for (int a = 0; a < g.rows; ++a) {
-        double* row = G[at + a];
-        for (int b = 0; b < nb; ++b) row[b] = 0;
-        if (!W) {
-          row[at + a] = cp.E[at + a];
-          continue;
-        }
-        for (int b = a; b < g.rows; ++b) row[at + b] = (*W)(a, b) * cp.E[at + b];
-      }
-      at += g.rows;
-    }
-    for (int k = 0; k < cp.f.rank; ++k) {  // G ← G H_k, H_k = 1 − τ v vᵀ, v = [0…0, 1, essential]
-      const double tau = cp.f.tau[k];
-      const int pk = cp.f.perm[k];
-      double v[12];
-      for (int b = k + 1; b < nb; ++b) v[b] = cp.f.a[b][pk];
-      for (int a = 0; a < nb; ++a) {
-        double* row = G[a];
-        double d = row[k];
-        for (int b = k + 1; b < nb; ++b) d += row[b] * v[b];
-        if (d == 0) continue;
-        d *= tau;
-        row[k] -= d;
-        for (int b = k + 1; b < nb; ++b) row[b] -= d * v[b];
-      }
-    }
-    for (int a = 0; a < nb; ++a)
-      for (int c = 0; c < z; ++c) F.col[c][a] = G[a][r + c];
-    if (kept == Kept::Mu) {
-      for (int a = 0; a < nb; ++a)
-        for (int c = 0; c < r; ++c) F.col[z + c][a] = G[a][c];
-    } else if (kept == Kept::Nu) {
-      switch (nd.u2form) {
-        case U2Form::Identity:
-          for (int a = 0; a < nb; ++a)
-            for (int c = 0; c < nk; ++c) F.col[z + c][a] = G[a][c];
-          break;
-        case U2Form::Reflector:  // U₂ = columns 1… of 1 − β u uᵀ
-          for (int a = 0; a < nb; ++a) {
-            double gu = 0;
-            for (int c = 0; c < r; ++c) gu += G[a][c] * nd.hu[c];
-            gu *= nd.hbeta;
-            for (int c = 0; c < nk; ++c) F.col[z + c][a] = G[a][c + 1] - gu * nd.hu[c + 1];
-          }
-          break;
-        case U2Form::Explicit:
-          for (int a = 0; a < nb; ++a)
-            for (int c = 0; c < nk; ++c) {
-              double v = 0;
-              for (int b = 0; b < r; ++b) v += G[a][b] * nd.U2(b, c);
-              F.col[z + c][a] = v;
-            }
-          break;
-      }
-    }
-  } else {
-    BufVec y;
-    KVec dmu(r), unit(nk);
-    BufVec t(z);
-    for (int c = 0; c < nvar; ++c) {
-      dmu.setZero();
-      t.setZero();
-      if (c < z) {
-        t[c] = 1;
-      } else if (kept == Kept::Mu) {
-        dmu[c - z] = 1;
-      } else {
-        unit.setZero();
-        unit[c - z] = 1;
-        addU2(nd, unit, dmu);
-      }
-      stacked(cp, dmu, t, y);
-      int at = 0;
-      for (int s = 0; s < cp.nseg; ++s) {
-        const Segment& g = cp.seg[s];
-        const SmallMat* W = segmentWeight(ws, nd, e, g);
-        for (int a = 0; a < g.rows; ++a) {
-          double v = W ? 0.0 : y[at + a];
-          if (W)
-            for (int b = a; b < g.rows; ++b) v += (*W)(a, b) * y[at + b];
-          F.col[c][at + a] = v;
-        }
-        at += g.rows;
-      }
-    }
-  }
+  if (!cp.soft)
+    hardColumns(ws, nd, e, cp, kept, F);
+  else
+    softColumns(ws, nd, e, cp, kept, F);
   // The right side: the current λ of own rows, the children's and the previous ρ.
   int at = 0;
   for (int s = 0; s < cp.nseg; ++s) {
@@ -234,26 +268,7 @@ void costOfCompression(TreeWorkspace& ws, int i, int e, Kept kept, const VecX& l
     for (int k = 0; k < g.rows; ++k) F.col[nvar][at + k] = in[k];
     at += g.rows;
   }
-  if (nd.locked && e == nd.ncomp - 1 && kept == Kept::Nu) {
-    // A locked joint's rows (tree_solver/locked.cpp): their force ℓ moves
-    // with the kept multipliers, δℓ = −(K s)ᵀ δμ, δμ = U₂ δν, and their λ =
-    // c ℓ / Σc² costs (ℓ + δℓ)² / Σc².
-    const double w = 1.0 / std::sqrt(nd.c2);
-    for (int c = 0; c < z; ++c) F.col[c][nb] = 0;
-    KVec unit(nk), dmu(nd.nK);
-    for (int c = 0; c < nk; ++c) {
-      unit.setZero();
-      unit[c] = 1;
-      dmu.setZero();
-      addU2(nd, unit, dmu);
-      F.col[z + c][nb] = -w * nd.gl.dot(dmu);
-    }
-    double ell = 0;
-    for (const JointRow& jr : nd.jrows)
-      if (jr.active) ell += jr.c * lambda[jr.global];
-    F.col[nvar][nb] = w * ell;
-    F.rows = nb + 1;
-  }
+  if (nd.locked && e == nd.ncomp - 1 && kept == Kept::Nu) lockedJointRow(nd, z, nk, lambda, F);
   triangularize(F, nvar);
   cp.mnTop.resize(z, nvar + 1);
   for (int c = 0; c <= nvar; ++c)

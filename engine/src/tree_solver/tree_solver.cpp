@@ -15,6 +15,109 @@ namespace appell {
 
 using detail::Segment;
 
+namespace {
+
+/// Where constraint c's rows go: a joint limit on a one-DoF joint to that
+/// joint's node (tree_solver/locked.cpp), a row between two bodies or in
+/// joint space to the loops, a row on one body to that body's stack.
+void placeConstraintRows(const Model& model, const Constraint& con, int c, int global,
+                         detail::TreeWorkspace& ws) {
+  const int rows = con.rows();
+  const int A = con.bodyA(), B = con.bodyB();
+  auto fail = [&](const std::string& why) {
+    throw std::invalid_argument("TreeSolver: constraint '" + con.name() + "' " + why);
+  };
+  if (rows < 0) fail("has a negative row count");
+  if (!con.jointSpace()) {
+    if (A >= model.nbodies || B >= model.nbodies)
+      fail("acts on a body index outside the model (" + std::to_string(model.nbodies) + " bodies)");
+    if (A < 0 && B < 0) fail("acts on no moving body (both bodies are the world)");
+    if (rows > 6) fail("writes " + std::to_string(rows) + " body rows (at most 6)");
+  }
+  int own_joint = -1;
+  if (con.jointSpace()) {
+    const std::vector<int> cols = con.jointColumns(model);
+    if (cols.size() == 1 && cols[0] >= 0 && cols[0] < model.nv) {
+      const int b = model.body_of_v[cols[0]];
+      if (model.joints[b].nv == 1) own_joint = b;
+    }
+  }
+  if (own_joint >= 0) {
+    auto& jr = ws.nodes[own_joint].jrows;
+    if (jr.empty()) ws.jrow_nodes.push_back(own_joint);
+    for (int r = 0; r < rows; ++r) {
+      detail::JointRow row;
+      row.constraint = c;
+      row.row = r;
+      row.global = global + r;
+      jr.push_back(row);
+    }
+  } else if (con.jointSpace() || (A >= 0 && B >= 0)) {
+    for (int r = 0; r < rows; ++r) ws.loops.push_back({c, r, global + r, con.jointSpace(), A, B});
+  } else if (rows > 0) {
+    detail::TreeBlock tb;
+    tb.constraint = c;
+    tb.body = A >= 0 ? A : B;
+    tb.sign = A >= 0 ? 1.0 : -1.0;
+    tb.rows = rows;
+    tb.declared = rows;
+    tb.global = global;
+    tb.rhs.setZero(rows);
+    ws.nodes[tb.body].groups.push_back({Segment::Block, static_cast<int>(ws.blocks.size()), rows});
+    ws.blocks.push_back(tb);
+  }
+}
+
+/// The factor's record (workspace.hpp, FactorRecord) at its largest.
+void sizeFactorRecord(const Model& model, detail::TreeWorkspace& ws) {
+  int length = 0;
+  for (const auto& tb : ws.blocks) length += 1 + 6 * tb.declared;
+  for (int b : ws.jrow_nodes) length += 2 * static_cast<int>(ws.nodes[b].jrows.size());
+  for (const auto& lr : ws.loops) length += lr.joint_space ? 1 + model.nv : 12;
+  ws.factor_record.rows.assign(length, 0.0);
+  ws.factor_record.next.assign(length, 0.0);
+  ws.factor_record.q = VecX::Zero(model.nq);
+}
+
+/// One free body (tree_solver/free_body.cpp) with a positive definite
+/// inertia: L⁻¹ of its constant factor I = L Lᵀ, formed once.
+void setUpFreeBody(const Model& model, const SolverOptions& options, detail::TreeWorkspace& ws) {
+  ws.free_body = options.free_body_closed_form && model.nbodies == 1 &&
+                 model.joints[0].type == JointType::Floating && ws.loops.empty() &&
+                 ws.jrow_nodes.empty() && model.spatial_inertia_factor[0](0, 0) > 0;
+  if (!ws.free_body) return;
+  ws.free_body_linv =
+      model.spatial_inertia_factor[0].triangularView<Eigen::Lower>().solve(Mat6::Identity());
+  // λ_min(I) = σ_min(L)²: the closed form's acceptance bound (free_body.cpp).
+  const Mat6& L = model.spatial_inertia_factor[0];
+  const Mat6 I = L * L.transpose();
+  ws.free_body_lambda_min = std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat6>(I).eigenvalues()[0]);
+}
+
+/// The loop closure's workspace (tree_solver/loops.cpp), for k loop rows.
+void sizeLoopWorkspace(const Model& model, int k, detail::TreeWorkspace& ws) {
+  ws.W = MatX::Zero(model.nv, k);
+  ws.L = MatX::Zero(ws.m, k);
+  ws.Z = MatX::Zero(6 * model.nbodies, k);
+  ws.z_svd = decltype(ws.z_svd)(6 * model.nbodies, k, Eigen::ComputeThinV);
+  // R_i = Λ^½ Vᵀ from I_i = V Λ Vᵀ: also for a body whose inertia is only
+  // semidefinite (a massless frame, a point mass).
+  ws.inertia_root.resize(model.nbodies);
+  for (int i = 0; i < model.nbodies; ++i) {
+    const Eigen::SelfAdjointEigenSolver<Mat6> es(model.spatial_inertia[i]);
+    ws.inertia_root[i] =
+        es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
+  }
+  ws.loop_null = MatX::Zero(ws.m, k);
+  ws.vdot0 = VecX::Zero(model.nv);
+  ws.lambda0 = VecX::Zero(ws.m);
+  for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda,
+                  &ws.loop_tmp, &ws.loop_resid, &ws.loop_share, &ws.loop_fnorm})
+    *x = VecX::Zero(k);
+}
+
+}  // namespace
+
 TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
                        const SolverOptions& options)
     : ws_(std::make_unique<detail::TreeWorkspace>()) {
@@ -23,87 +126,18 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   ws.nbodies = model.nbodies;
   ws.nv = model.nv;
   ws.nodes.resize(model.nbodies);
-
   int global = 0;
   for (size_t c = 0; c < constraints.size(); ++c) {
     const Constraint& con = *constraints[c];
     ws.names.push_back(con.name());
     ws.unilateral_row.push_back(con.unilateralRow());
-    const int rows = con.rows();
-    const int A = con.bodyA(), B = con.bodyB();
-    auto fail = [&](const std::string& why) {
-      throw std::invalid_argument("TreeSolver: constraint '" + con.name() + "' " + why);
-    };
-    if (rows < 0) fail("has a negative row count");
-    if (!con.jointSpace()) {
-      if (A >= model.nbodies || B >= model.nbodies)
-        fail("acts on a body index outside the model (" + std::to_string(model.nbodies) +
-             " bodies)");
-      if (A < 0 && B < 0) fail("acts on no moving body (both bodies are the world)");
-      if (rows > 6) fail("writes " + std::to_string(rows) + " body rows (at most 6)");
-    }
-    // A joint-space constraint on the one velocity of a one-DoF joint (a
-    // joint limit) is taken by that joint's node (tree_solver/locked.cpp).
-    int own_joint = -1;
-    if (con.jointSpace()) {
-      const std::vector<int> cols = con.jointColumns(model);
-      if (cols.size() == 1 && cols[0] >= 0 && cols[0] < model.nv) {
-        const int b = model.body_of_v[cols[0]];
-        if (model.joints[b].nv == 1) own_joint = b;
-      }
-    }
-    if (own_joint >= 0) {
-      auto& jr = ws.nodes[own_joint].jrows;
-      if (jr.empty()) ws.jrow_nodes.push_back(own_joint);
-      for (int r = 0; r < rows; ++r) {
-        detail::JointRow row;
-        row.constraint = static_cast<int>(c);
-        row.row = r;
-        row.global = global + r;
-        jr.push_back(row);
-      }
-    } else if (con.jointSpace() || (A >= 0 && B >= 0)) {
-      for (int r = 0; r < rows; ++r)
-        ws.loops.push_back({static_cast<int>(c), r, global + r, con.jointSpace(), A, B});
-    } else if (rows > 0) {
-      detail::TreeBlock tb;
-      tb.constraint = static_cast<int>(c);
-      tb.body = A >= 0 ? A : B;
-      tb.sign = A >= 0 ? 1.0 : -1.0;
-      tb.rows = rows;
-      tb.declared = rows;
-      tb.global = global;
-      tb.rhs.setZero(rows);
-      ws.nodes[tb.body].groups.push_back({Segment::Block, static_cast<int>(ws.blocks.size()), rows});
-      ws.blocks.push_back(tb);
-    }
-    global += rows;
+    placeConstraintRows(model, con, static_cast<int>(c), global, ws);
+    global += con.rows();
   }
   ws.m = global;
-  {  // the factor's record (workspace.hpp, FactorRecord) at its largest
-    int length = 0;
-    for (const auto& tb : ws.blocks) length += 1 + 6 * tb.declared;
-    for (int b : ws.jrow_nodes) length += 2 * static_cast<int>(ws.nodes[b].jrows.size());
-    for (const auto& lr : ws.loops) length += lr.joint_space ? 1 + model.nv : 12;
-    ws.factor_record.rows.assign(length, 0.0);
-    ws.factor_record.next.assign(length, 0.0);
-    ws.factor_record.q = VecX::Zero(model.nq);
-  }
+  sizeFactorRecord(model, ws);
   std::sort(ws.jrow_nodes.begin(), ws.jrow_nodes.end());
-  // One free body (tree_solver/free_body.cpp) with a positive definite
-  // inertia: L⁻¹ of its constant factor I = L Lᵀ, formed once.
-  ws.free_body = options.free_body_closed_form && model.nbodies == 1 &&
-                 model.joints[0].type == JointType::Floating && ws.loops.empty() &&
-                 ws.jrow_nodes.empty() && model.spatial_inertia_factor[0](0, 0) > 0;
-  if (ws.free_body) {
-    ws.free_body_linv = model.spatial_inertia_factor[0].triangularView<Eigen::Lower>().solve(
-        Mat6::Identity());
-    // λ_min(I) = σ_min(L)²: the closed form's acceptance bound (free_body.cpp).
-    const Mat6& L = model.spatial_inertia_factor[0];
-    const Mat6 I = L * L.transpose();
-    ws.free_body_lambda_min =
-        std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat6>(I).eigenvalues()[0]);
-  }
+  setUpFreeBody(model, options, ws);
   for (int i = 0; i < model.nbodies; ++i)
     for (int ch : model.children[i]) ws.nodes[i].groups.push_back({Segment::Child, ch, 0});
   for (auto& nd : ws.nodes) {
@@ -127,26 +161,7 @@ TreeSolver::TreeSolver(const Model& model, const ConstraintList& constraints,
   ws.fsub.assign(model.nbodies, Vec6::Zero());
   ws.floop.assign(model.nbodies, Vec6::Zero());
   ws.a0.assign(model.nbodies, Vec6::Zero());
-  const int k = static_cast<int>(ws.loops.size());
-  if (k > 0) {
-    ws.W = MatX::Zero(model.nv, k);
-    ws.L = MatX::Zero(ws.m, k);
-    ws.Z = MatX::Zero(6 * model.nbodies, k);
-    ws.z_svd = decltype(ws.z_svd)(6 * model.nbodies, k, Eigen::ComputeThinV);
-    // R_i = Λ^½ Vᵀ from I_i = V Λ Vᵀ: also for a body whose inertia is only
-    // semidefinite (a massless frame, a point mass).
-    ws.inertia_root.resize(model.nbodies);
-    for (int i = 0; i < model.nbodies; ++i) {
-      const Eigen::SelfAdjointEigenSolver<Mat6> es(model.spatial_inertia[i]);
-      ws.inertia_root[i] = es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() *
-                           es.eigenvectors().transpose();
-    }
-    ws.loop_null = MatX::Zero(ws.m, k);
-    ws.vdot0 = VecX::Zero(model.nv);
-    ws.lambda0 = VecX::Zero(ws.m);
-    for (VecX* x : {&ws.loop_target, &ws.loop_rhs, &ws.loop_res, &ws.loop_scale, &ws.loop_lambda, &ws.loop_tmp, &ws.loop_resid, &ws.loop_share, &ws.loop_fnorm})
-      *x = VecX::Zero(k);
-  }
+  if (!ws.loops.empty()) sizeLoopWorkspace(model, static_cast<int>(ws.loops.size()), ws);
 }
 
 TreeSolver::~TreeSolver() = default;
