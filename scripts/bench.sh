@@ -6,6 +6,8 @@
 #     long_run.{md,csv,gp,png}, peers.{md,csv,gp,png};
 #   - the Python bindings' thread scaling (python/bench/thread_scaling.py)
 #     → tables/thread_scaling.md;
+#   - `appell info`'s wall time per description (bench/report_info_times.py)
+#     → info_times.md (published robots timed when ROS_PACKAGE_PATH is set);
 #   - the peers (Simbody, MuJoCo) are installed first (scripts/install-peers.sh).
 # Each page names the command that made it. The analyses in bench/RESULTS.md
 # and bench/results/*.md quote dated runs and link to these pages.
@@ -41,6 +43,7 @@ declare -A ARGS=(
   [report_long_run]="--steps 1000000 --dt 0.01 --out $OUT"
   [report_peers]="--repeats 3 --out $OUT"
   [thread_scaling]="--repeat 5"
+  [report_info_times]="--repeats 5 --out $OUT/info_times.md"
 )
 
 # run NAME: one program, its output where its page expects it.
@@ -49,6 +52,7 @@ run() {
   [ -n "${ARGS[$name]+x}" ] || { echo "bench.sh: no benchmark named '$name' (one of: ${!ARGS[*]})" >&2; return 2; }
   [ "$name" = report_peers ] && exe=build/bench/peers/report_peers
   [ "$name" = thread_scaling ] && exe=python/bench/thread_scaling.py
+  [ "$name" = report_info_times ] && exe=bench/report_info_times.py
   [ -e "$exe" ] || { echo "bench.sh: $exe was not built" >&2; return 1; }
   start=$(date +%s)
   local -a args
@@ -57,6 +61,8 @@ run() {
     "$exe" "${args[@]}" --benchmark_out="$OUT/data/$name.json" --benchmark_out_format=json \
       > "$OUT/data/$name.log" 2>&1
     /usr/bin/python3 bench/tables.py "$OUT/data/$name.json" "$exe ${ARGS[$name]}" "$OUT/tables/$name.md"
+  elif [ "$name" = report_info_times ]; then
+    /usr/bin/python3 "$exe" --cli build/cli/appell "${args[@]}" > "$OUT/data/$name.log" 2>&1
   elif [ "$name" = thread_scaling ]; then
     PYTHONPATH=build/python /usr/bin/python3 "$exe" "${args[@]}" > "$OUT/data/$name.log" 2>&1
     /usr/bin/python3 bench/tables.py "$OUT/data/$name.log" \
@@ -71,7 +77,7 @@ run() {
 }
 
 ALL=(bm_dynamics bm_evaluation bm_constrained_scaling bm_events bm_friction bm_collision bm_parallel
-     report_speed_error report_long_run report_peers thread_scaling)
+     report_speed_error report_long_run report_peers thread_scaling report_info_times)
 total_start=$(date +%s)
 for name in "${@:-${ALL[@]}}"; do run "$name"; done
 echo "bench.sh: all done in $(( $(date +%s) - total_start )) s; results in $OUT"
