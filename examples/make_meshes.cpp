@@ -1,7 +1,8 @@
-// Writes the wheel meshes of the differential-drive example:
-//   wheel.stl  binary STL
-//   wheel.dae  Collada 1.4.1 (the same triangles)
-// then reads both back through appell::loadMesh (assimp) as a check.
+// Writes the examples' meshes, then reads each back through appell::loadMesh
+// (assimp) as a check:
+//   diff_drive/meshes/wheel.stl  the differential drive's wheel, binary STL
+//   diff_drive/meshes/wheel.dae  the same triangles, Collada 1.4.1
+//   biped/meshes/sole.stl        the mesh-footed biped's sole, binary STL
 //
 // The wheel is a solid of revolution about the y axis (the axle, as in the
 // diff_drive URDF: no visual rotation needed), radius 0.1 m, width 0.04 m: a
@@ -10,8 +11,14 @@
 // is revolved in `kSegments` steps. The solid is convex, so each triangle is
 // oriented with its normal pointing away from the wheel centre.
 //
-// usage: example_make_meshes [OUTDIR]   (default examples/diff_drive/meshes,
-//        relative to the current folder: run it from the repository root)
+// The sole is what a CAD exporter writes for a foot: a flat-bottomed prism,
+// 0.22 × 0.12 m in plan with 0.03 m corner fillets (kFilletSegments facets
+// each), 0.04 m thick and centred on its origin like the box sole of
+// examples/biped, in single precision as binary STL stores it — so the
+// fillets' coordinates carry float rounding.
+//
+// usage: example_make_meshes [EXAMPLES_DIR]   (default examples, relative to
+//        the current folder: run it from the repository root)
 #include <appell/urdf.hpp>
 
 #include <array>
@@ -34,6 +41,9 @@ constexpr double kRadius = 0.1;      // outer radius of the tyre
 constexpr double kTube = 0.02;       // tyre tube radius = half the width
 constexpr int kSegments = 64;        // around the axle
 constexpr int kArc = 16;             // intervals along the tyre's half circle
+constexpr double kSoleLength = 0.22, kSoleWidth = 0.12, kSoleThickness = 0.04;
+constexpr double kFillet = 0.03;     // the sole's corner radius in plan
+constexpr int kFilletSegments = 6;   // facets per corner fillet
 
 struct Mesh {
   std::vector<P3> v;
@@ -47,7 +57,7 @@ P3 cross(const P3& a, const P3& b) {
 double dot(const P3& a, const P3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // Adds a triangle, flipped if needed so its normal points away from the origin
-// (the wheel centre): valid because the wheel is convex.
+// (the wheel's or the sole's centre): valid because both solids are convex.
 void addOutward(Mesh& m, int a, int b, int c) {
   const P3 n = cross(sub(m.v[b], m.v[a]), sub(m.v[c], m.v[a]));
   const P3 g = {(m.v[a][0] + m.v[b][0] + m.v[c][0]) / 3, (m.v[a][1] + m.v[b][1] + m.v[c][1]) / 3,
@@ -89,12 +99,37 @@ Mesh wheel() {
   return m;
 }
 
-void writeStl(const Mesh& m, const std::string& path) {
+Mesh sole() {
+  // The outline in plan, counter-clockwise: four quarter circles.
+  std::vector<std::array<double, 2>> outline;
+  const double cx = kSoleLength / 2 - kFillet, cy = kSoleWidth / 2 - kFillet;
+  const double corner[4][2] = {{cx, cy}, {-cx, cy}, {-cx, -cy}, {cx, -cy}};
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k <= kFilletSegments; ++k) {
+      const double a = std::numbers::pi / 2 * (c + static_cast<double>(k) / kFilletSegments);
+      outline.push_back({corner[c][0] + kFillet * std::cos(a), corner[c][1] + kFillet * std::sin(a)});
+    }
+  const int n = static_cast<int>(outline.size());
+  Mesh m;
+  for (const double z : {-kSoleThickness / 2, kSoleThickness / 2})
+    for (const auto& [x, y] : outline) m.v.push_back({x, y, z});
+  for (int i = 0; i < n; ++i) {  // the side wall
+    const int j = (i + 1) % n;
+    addOutward(m, i, j, n + j);
+    addOutward(m, i, n + j, n + i);
+  }
+  for (int i = 1; i + 1 < n; ++i) {  // bottom and top: fans of the convex outline
+    addOutward(m, 0, i, i + 1);
+    addOutward(m, n, n + i, n + i + 1);
+  }
+  return m;
+}
+
+void writeStl(const Mesh& m, const std::string& path, const char* what) {
   std::ofstream out(path, std::ios::binary);
   if (!out) throw std::runtime_error("cannot write " + path);
   char header[80] = {};
-  std::snprintf(header, sizeof header, "appell wheel r=%.3f w=%.3f (examples/make_meshes.cpp)",
-                kRadius, 2 * kTube);
+  std::snprintf(header, sizeof header, "appell %s (examples/make_meshes.cpp)", what);
   out.write(header, 80);
   const std::uint32_t n = static_cast<std::uint32_t>(m.t.size());
   out.write(reinterpret_cast<const char*>(&n), 4);  // STL is little-endian, as is x86
@@ -163,29 +198,36 @@ void writeDae(const Mesh& m, const std::string& path) {
 )";
 }
 
+// Reads a written mesh back the way scenes load it and prints its extent.
+void report(const std::string& path) {
+  const appell::TriangleMesh t = appell::loadMesh(path);
+  appell::Vec3 lo = t.vertices.front(), hi = lo;
+  for (const appell::Vec3& p : t.vertices) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  std::cout << path << ": " << t.vertices.size() << " vertices, " << t.triangles.size()
+            << " triangles, extent " << (hi - lo).transpose() << " m, "
+            << std::filesystem::file_size(path) << " bytes\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::filesystem::path dir = argc > 1 ? argv[1] : "examples/diff_drive/meshes";
+  const std::filesystem::path root = argc > 1 ? argv[1] : "examples";
   try {
-    std::filesystem::create_directories(dir);
-    const Mesh m = wheel();
-    const std::string stl = (dir / "wheel.stl").string(), dae = (dir / "wheel.dae").string();
-    writeStl(m, stl);
-    writeDae(m, dae);
-    // Read both back the way scenes load them.
-    for (const std::string& path : {stl, dae}) {
-      const appell::TriangleMesh t = appell::loadMesh(path);
-      double rmax = 0, ymin = 0, ymax = 0;
-      for (const appell::Vec3& p : t.vertices) {
-        rmax = std::max(rmax, std::hypot(p.x(), p.z()));
-        ymin = std::min(ymin, p.y());
-        ymax = std::max(ymax, p.y());
-      }
-      std::cout << path << ": " << t.vertices.size() << " vertices, " << t.triangles.size()
-                << " triangles, radius " << rmax << " m, width " << ymax - ymin << " m, "
-                << std::filesystem::file_size(path) << " bytes\n";
-    }
+    const std::filesystem::path wheels = root / "diff_drive" / "meshes", soles = root / "biped" / "meshes";
+    std::filesystem::create_directories(wheels);
+    std::filesystem::create_directories(soles);
+    char what[64];
+    std::snprintf(what, sizeof what, "wheel r=%.3f w=%.3f", kRadius, 2 * kTube);
+    const Mesh w = wheel();
+    writeStl(w, (wheels / "wheel.stl").string(), what);
+    writeDae(w, (wheels / "wheel.dae").string());
+    std::snprintf(what, sizeof what, "sole %.2fx%.2fx%.2f fillet %.2f", kSoleLength, kSoleWidth,
+                  kSoleThickness, kFillet);
+    writeStl(sole(), (soles / "sole.stl").string(), what);
+    for (const auto& path : {wheels / "wheel.stl", wheels / "wheel.dae", soles / "sole.stl"}) report(path.string());
   } catch (const std::exception& e) {
     std::cerr << "make_meshes: " << e.what() << "\n";
     return 1;

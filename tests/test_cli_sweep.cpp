@@ -99,6 +99,39 @@ TEST(CliSweep, JsonAndCsvCarryTheCppApiResultsAtFullPrecision) {
   EXPECT_NE(csv.output.find(std::string("5,stable,") + buf), std::string::npos) << csv.output << buf;
 }
 
+// The Whipple bicycle (examples/bicycle): running straight is steady at any
+// speed, so its own direction is a null vector of L and the zero tolerance
+// would hide where the capsize eigenvalue crosses 0. With --family that
+// direction is removed and one sweep finds Meijaard et al. (2007)'s weave
+// and capsize speeds (§5: 4.29238253634111 and 6.02426201538837 m/s) by
+// bisection on the sign of the largest real part. Measured: 2e-9 and 3e-8
+// m/s, the finite-difference L's accuracy (tests/test_linearization_bicycle.cpp).
+TEST(CliSweep, BicycleWeaveAndCapsizeSpeedsByOneSweepOfAFamily) {
+  const std::string bike = std::string(APPELL_SOURCE_DIR) + "/examples/bicycle/bicycle.urdf";
+  const std::string cyclic = " --cyclic plane.x,plane.y,plane.theta,rear_spin,front_spin";
+  const auto r = sh("linearize " + bike + cyclic + " --sweep plane.vx=3:7:5 --family --format json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::vector<double> changes = numbersAfter(r.output, "\"stability_changes\": [");
+  ASSERT_EQ(changes.size(), 2u) << r.output;
+  EXPECT_NEAR(changes[0], 4.29238253634111, 1e-7) << r.output;
+  EXPECT_NEAR(changes[1], 6.02426201538837, 1e-7) << r.output;
+  // Without --family the speed's own zero eigenvalue sits at the threshold:
+  // the capsize change is found only to the zero tolerance, if at all.
+  const auto coarse = sh("linearize " + bike + cyclic + " --sweep plane.vx=3:7:5 --format json");
+  ASSERT_EQ(coarse.status, 0) << coarse.output;
+  const std::vector<double> rough = numbersAfter(coarse.output, "\"stability_changes\": [");
+  bool capsize_to_1e7 = false;
+  for (double c : rough) capsize_to_1e7 = capsize_to_1e7 || std::abs(c - 6.02426201538837) < 1e-7;
+  EXPECT_FALSE(capsize_to_1e7) << coarse.output;
+  // At rest there is no family to remove; an equilibrium has none either.
+  const auto rest = sh("linearize " + bike + cyclic + " --set plane.vx=0 --family");
+  EXPECT_EQ(rest.status, 2) << rest.output;
+  EXPECT_NE(rest.output.find("--family: the reference velocity is zero"), std::string::npos) << rest.output;
+  const auto eq = sh("linearize " + bike + " --equilibrium --family");
+  EXPECT_EQ(eq.status, 2) << eq.output;
+  EXPECT_NE(eq.output.find("an equilibrium (v = 0) has none"), std::string::npos) << eq.output;
+}
+
 // Overrides that cannot be applied say why: an unknown name, a vector of the
 // wrong size, a velocity the constraints forbid, speed without a floating base.
 TEST(CliSweep, BadOverridesAreNamed) {

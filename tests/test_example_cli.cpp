@@ -206,16 +206,16 @@ TEST(ExampleGenerators, MakeNTrailerRejectsBadArguments) {
 
 TEST(ExampleGenerators, MakeMeshesReproducesTheCommittedMeshes) {
   TempDir dir;
-  const std::string out = dir / "meshes";
+  const std::string out = dir / "examples";
   const Output o = runCommand(program("examples/example_make_meshes") + " " + out);
   ASSERT_EQ(o.status, 0) << o.output;
-  EXPECT_NE(o.output.find("2176 triangles"), std::string::npos) << o.output;
-  for (const char* f : {"wheel.stl", "wheel.dae"}) {
-    const std::string made = readFile(out + "/" + f), committed = readFile(example(std::string("diff_drive/meshes/") + f));
+  EXPECT_NE(o.output.find("2176 triangles"), std::string::npos) << o.output;  // the wheel
+  EXPECT_NE(o.output.find("sole.stl: 56 vertices, 108 triangles"), std::string::npos) << o.output;
+  for (const char* f : {"diff_drive/meshes/wheel.stl", "diff_drive/meshes/wheel.dae", "biped/meshes/sole.stl"}) {
+    const std::string made = readFile(out + "/" + f), committed = readFile(example(f));
     EXPECT_FALSE(made.empty()) << f;
     EXPECT_LT(made.size(), 200u * 1024) << f;
-    EXPECT_TRUE(made == committed) << "examples/diff_drive/meshes/" << f
-                                   << " is stale: regenerate it (docs/examples.md)";
+    EXPECT_TRUE(made == committed) << "examples/" << f << " is stale: regenerate it (docs/examples.md)";
   }
 }
 
