@@ -10,6 +10,8 @@
 #include <appell/linearization.hpp>
 #include <appell/output.hpp>
 
+#include <Eigen/QR>
+
 #include <algorithm>
 #include <complex>
 #include <cstdio>
@@ -46,6 +48,14 @@ scene's initial state and prints the eigenvalues.
                       linearize at COUNT values of a one-number override, on all
                       cores; prints the largest real part per value and the values
                       where stability changes
+  --family            the reference is one of a family of steady motions along
+                      its own velocity (a bicycle running straight is steady at
+                      any speed): that direction, (0, v) in the reduced state, is
+                      a null vector of the linearization; it is removed (the
+                      eigenvalues of the quotient Uᵀ L U, U spanning its
+                      orthogonal complement) and a --sweep's stability changes
+                      are located where the largest real part crosses 0, to
+                      1e-9 relative, not where it crosses the zero tolerance
   --format F          text (default), csv or json — full precision
   --plot FILE.png     with --sweep: the stability diagram (largest real part
                       against the swept parameter), drawn by gnuplot
@@ -61,7 +71,33 @@ struct Analysis {
   std::vector<std::complex<double>> eigenvalues;  ///< largest real part first
   double tol = 0, max_real = 0;
   int zeros = 0;
+  bool family = false;         ///< --family: the family's direction removed
+  double family_residual = 0;  ///< |L z₀| / |L|, z₀ the family's direction
+  /// The threshold of growth: the zero tolerance, or 0 once a family's own
+  /// null direction is removed (its boundaries are where a real part crosses 0).
+  double growthThreshold() const { return family ? 0.0 : tol; }
+  bool unstable() const { return max_real > growthThreshold(); }
 };
+
+// The eigenvalues of the quotient by a family of steady motions along the
+// reference velocity v: z₀ = Zᵀ (0, v/|v|) in the tangent basis Z, U an
+// orthonormal basis of z₀'s complement (Householder), the spectrum of Uᵀ L U.
+std::vector<std::complex<double>> familyQuotient(const LinearizationResult& r, const VecX& v, double& residual) {
+  // Below 1e-9 in every coordinate the velocity is the constraints' round-off
+  // (a bicycle set to rest keeps a front spin of 1e-15): no direction at all.
+  if (!(v.lpNorm<Eigen::Infinity>() > 1e-9))
+    throw UsageError("--family: the reference velocity is zero, so it spans no family");
+  VecX x0 = VecX::Zero(r.basis.rows());
+  x0.tail(v.size()) = v.normalized();
+  const VecX z0 = r.basis.transpose() * x0;
+  if (!(z0.norm() > 0.5))
+    throw UsageError("--family: the reference velocity leaves the tangent space of the constraints");
+  residual = (r.matrix * z0).norm() / std::max(r.matrix.norm(), 1e-300);
+  const MatX q = Eigen::HouseholderQR<MatX>(z0).householderQ();
+  const MatX u = q.rightCols(r.dimension - 1);
+  const Eigen::VectorXcd e = Eigen::EigenSolver<MatX>(u.transpose() * r.matrix * u, false).eigenvalues();
+  return {e.data(), e.data() + e.size()};
+}
 
 // One linearization of `scene` as the options say.
 Analysis analyse(const Scene& scene, const Args& args, const std::vector<int>& cyclic, Formulation form,
@@ -90,7 +126,11 @@ Analysis analyse(const Scene& scene, const Args& args, const std::vector<int>& c
   auto solver = makeSolver(form, m, scene.constraints);
   a.result = linearize(m, scene.constraints, *solver, q, v, lo);
   const LinearizationResult& r = a.result;
-  a.eigenvalues.assign(r.eigenvalues.data(), r.eigenvalues.data() + r.eigenvalues.size());
+  a.family = args.has("family");
+  if (a.family)
+    a.eigenvalues = familyQuotient(r, v, a.family_residual);
+  else
+    a.eigenvalues.assign(r.eigenvalues.data(), r.eigenvalues.data() + r.eigenvalues.size());
   std::sort(a.eigenvalues.begin(), a.eigenvalues.end(), [](auto x, auto y) {
     return x.real() != y.real() ? x.real() > y.real() : x.imag() > y.imag();
   });
@@ -99,12 +139,20 @@ Analysis analyse(const Scene& scene, const Args& args, const std::vector<int>& c
   double scale = 1.0;
   for (const auto& z : a.eigenvalues) scale = std::max(scale, std::abs(z));
   a.tol = args.positiveNumber("zero-tol", 1e-4) * scale;
-  a.zeros = countZeroEigenvalues(r, a.tol);
+  a.zeros = static_cast<int>(std::count_if(a.eigenvalues.begin(), a.eigenvalues.end(),
+                                            [&](const auto& z) { return std::abs(z) <= a.tol; }));
   a.max_real = a.eigenvalues.empty() ? 0.0 : a.eigenvalues.front().real();
   if (r.steady_residual > 1e-6 * scale || r.constraint_residual > 1e-8) {
     std::ostringstream s;
     s << "the reference state is not an equilibrium or steady motion (steady residual "
       << r.steady_residual << ")";
+    a.message = s.str();
+    return a;
+  }
+  if (a.family && a.family_residual > 1e-6) {
+    std::ostringstream s;
+    s << "the reference velocity is not the direction of a family of steady motions (|L z0| / |L| = "
+      << a.family_residual << "): drop --family";
     a.message = s.str();
     return a;
   }
@@ -126,8 +174,10 @@ int printOne(const Scene& scene, const Analysis& a, const std::vector<int>& cycl
               << ", \"steady_residual\": " << full(r.steady_residual) << ", \"eigenvalues\": [";
     for (std::size_t k = 0; k < a.eigenvalues.size(); ++k)
       std::cout << (k ? ", " : "") << "[" << full(a.eigenvalues[k].real()) << ", " << full(a.eigenvalues[k].imag()) << "]";
-    std::cout << "], \"zero_eigenvalues\": " << a.zeros << ", \"max_real\": " << full(a.max_real)
-              << ", \"verdict\": \"" << (!a.ok ? "none" : a.max_real > a.tol ? "unstable" : "not growing") << "\"}\n";
+    std::cout << "]";
+    if (a.family) std::cout << ", \"family_residual\": " << full(a.family_residual);
+    std::cout << ", \"zero_eigenvalues\": " << a.zeros << ", \"max_real\": " << full(a.max_real)
+              << ", \"verdict\": \"" << (!a.ok ? "none" : a.unstable() ? "unstable" : "not growing") << "\"}\n";
     return a.ok ? 0 : 3;
   }
   if (format == "csv") {
@@ -143,12 +193,15 @@ int printOne(const Scene& scene, const Analysis& a, const std::vector<int>& cycl
   std::cout << "\neigenvalues (real, imag):\n" << std::setprecision(8);
   for (const auto& z : a.eigenvalues)
     std::cout << "  " << std::setw(16) << z.real() << "  " << std::setw(16) << z.imag() << "\n";
+  if (a.family)
+    std::cout << "the family's direction (0, v) removed: |L z0| / |L| = " << a.family_residual
+              << "; growth is a real part above 0\n";
   std::cout << a.zeros << " zero eigenvalues (|μ| < " << a.tol << " = zero-tol × max(1, max |μ|))\n";
   if (!a.ok) {
     std::cout << "no stability verdict: " << a.message << "; try --equilibrium or --cyclic\n";
     return 3;
   }
-  std::cout << (a.max_real > a.tol ? "unstable: largest real part " + std::to_string(a.max_real)
+  std::cout << (a.unstable() ? "unstable: largest real part " + std::to_string(a.max_real)
                                    : std::string("no exponentially growing mode (to within the zero tolerance)"))
             << "\n";
   return 0;
@@ -193,14 +246,14 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
     applyOverride(s, sw.name, full(value), kept);
     completeSetVelocities(s, kept);
     const Analysis a = analyse(s, args, cyclic, form, false);
-    return std::pair<bool, bool>(a.ok, a.max_real > a.tol);
+    return std::pair<bool, bool>(a.ok, a.unstable());
   };
   std::vector<double> changes;
   for (std::size_t k = 1; k < out.size(); ++k) {
     const Analysis &a = out[k - 1], &b = out[k];
-    if (!a.ok || !b.ok || (a.max_real > a.tol) == (b.max_real > b.tol)) continue;
+    if (!a.ok || !b.ok || (a.unstable()) == (b.unstable())) continue;
     double lo = sw.values[k - 1], hi = sw.values[k];
-    const bool lo_unstable = a.max_real > a.tol;
+    const bool lo_unstable = a.unstable();
     for (int it = 0; it < 60 && std::abs(hi - lo) > 1e-9 * std::max(1.0, std::abs(lo)); ++it) {
       const double mid = 0.5 * (lo + hi);
       const auto [ok, u] = unstable(mid);
@@ -214,7 +267,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
     for (std::size_t k = 0; k < out.size(); ++k) {
       const Analysis& a = out[k];
       std::cout << (k ? ",\n  " : "\n  ") << "{\"value\": " << full(sw.values[k]) << ", \"verdict\": \""
-                << (!a.ok ? "none" : a.max_real > a.tol ? "unstable" : "not growing")
+                << (!a.ok ? "none" : a.unstable() ? "unstable" : "not growing")
                 << "\", \"max_real\": " << full(a.max_real) << ", \"eigenvalues\": [";
       for (std::size_t i = 0; i < a.eigenvalues.size(); ++i)
         std::cout << (i ? ", " : "") << "[" << full(a.eigenvalues[i].real()) << ", " << full(a.eigenvalues[i].imag()) << "]";
@@ -231,7 +284,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
     std::cout << "\n";
     for (std::size_t k = 0; k < out.size(); ++k) {
       const Analysis& a = out[k];
-      std::cout << full(sw.values[k]) << "," << (!a.ok ? "none" : a.max_real > a.tol ? "unstable" : "stable")
+      std::cout << full(sw.values[k]) << "," << (!a.ok ? "none" : a.unstable() ? "unstable" : "stable")
                 << "," << full(a.max_real);
       for (std::size_t i = 0; i < n; ++i)
         if (i < a.eigenvalues.size()) std::cout << "," << full(a.eigenvalues[i].real()) << "," << full(a.eigenvalues[i].imag());
@@ -245,7 +298,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
     for (std::size_t k = 0; k < out.size(); ++k) {
       const Analysis& a = out[k];
       std::cout << std::setprecision(8) << std::setw(16) << sw.values[k] << std::setw(18) << a.max_real << "  "
-                << (!a.ok ? "no verdict: " + a.message : a.max_real > a.tol ? "unstable" : "no growing mode") << "\n";
+                << (!a.ok ? "no verdict: " + a.message : a.unstable() ? "unstable" : "no growing mode") << "\n";
     }
     if (changes.empty()) std::cout << "stability does not change over the sweep\n";
     for (double c : changes) std::cout << "stability changes at " << sw.name << " ≈ " << std::setprecision(10) << c << "\n";
@@ -269,7 +322,7 @@ int linearize(int argc, char** argv) {
   Args args(argc, argv, 2,
             {"cyclic", "formulation", "zero-tol", "package-path", "fd-step", "set", "sweep", "format", "plot",
              "bound-inertia", "bound-mass"},
-            {"help", "equilibrium", "project-initial", "no-joint-limits", "balance-inertia"});
+            {"help", "equilibrium", "project-initial", "no-joint-limits", "balance-inertia", "family"});
   if (args.has("help")) {
     std::cout << helpText(kLinearizeHelp);
     return 0;
@@ -278,6 +331,8 @@ int linearize(int argc, char** argv) {
   if (format != "text" && format != "csv" && format != "json")
     throw UsageError("--format must be text, csv or json, not '" + format + "'");
   if (args.has("plot") && !args.has("sweep")) throw UsageError("--plot draws a --sweep's stability diagram");
+  if (args.has("family") && args.has("equilibrium"))
+    throw UsageError("--family removes a steady motion's own direction; an equilibrium (v = 0) has none");
   // Overrides change the state: check it after them, not at load.
   const bool overrides = !args.all("set").empty();
   Scene scene = loadFromArgs(args, !args.has("equilibrium") && !overrides);
