@@ -129,6 +129,8 @@ struct MujocoVehicle {
     // angular velocity in the body frame.
     c.velocity = V3(d->qvel[0], d->qvel[1], d->qvel[2]);
     c.omega = c.rotation * V3(d->qvel[3], d->qvel[4], d->qvel[5]);
+    if (m->nv == 10)
+      for (int i = 0; i < 4; ++i) c.wheel_rate[i] = d->qvel[6 + i];  // the hinges, in body order
     return c;
   }
   double penetration() const {

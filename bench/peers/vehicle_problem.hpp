@@ -86,6 +86,7 @@ struct ChassisSample {
   M3 rotation = M3::Identity();
   V3 velocity = V3::Zero();
   V3 omega = V3::Zero();
+  std::array<double, 4> wheel_rate{};  ///< wheel joint rates (rad/s), FL FR RL RR; 0 when locked
   /// Velocity of the link origin along the chassis' x axis (forward) and y.
   double forward() const { return velocity.dot(rotation.col(0)); }
   double lateral() const { return velocity.dot(rotation.col(1)); }
