@@ -32,6 +32,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <sstream>
@@ -131,7 +132,31 @@ struct MujocoVehicle {
     c.omega = c.rotation * V3(d->qvel[3], d->qvel[4], d->qvel[5]);
     if (m->nv == 10)
       for (int i = 0; i < 4; ++i) c.wheel_rate[i] = d->qvel[6 + i];  // the hinges, in body order
+    c.contacts = d->ncon;
+    c.friction_angle = frictionAngle();
     return c;
+  }
+  /// The largest angle between a contact's friction force and the opposite
+  /// of its slip (the velocity of the wheel's material point at the contact),
+  /// over contacts slipping faster than 1 mm/s.
+  double frictionAngle() const {
+    double worst = 0;
+    for (int k = 0; k < d->ncon; ++k) {
+      const mjContact& con = d->contact[k];
+      mjtNum f[6], vel[6];
+      mj_contactForce(m, d, k, f);
+      const int body = m->geom_bodyid[con.geom2 > 0 ? con.geom2 : con.geom1];
+      mj_objectVelocity(m, d, mjOBJ_BODY, body, vel, 0);  // world frame: angular, then linear at the origin
+      const V3 w(vel[0], vel[1], vel[2]), vo(vel[3], vel[4], vel[5]);
+      const V3 arm = V3(con.pos[0], con.pos[1], con.pos[2]) - V3(d->xpos[3 * body], d->xpos[3 * body + 1], d->xpos[3 * body + 2]);
+      const V3 slip = vo + w.cross(arm);
+      const V3 t1(con.frame[3], con.frame[4], con.frame[5]), t2(con.frame[6], con.frame[7], con.frame[8]);
+      const V3 ft = f[1] * t1 + f[2] * t2;  // friction in the world (the frame's rows: normal, t1, t2)
+      const V3 st = slip - slip.dot(V3(con.frame[0], con.frame[1], con.frame[2])) * V3(con.frame[0], con.frame[1], con.frame[2]);
+      if (st.norm() < 1e-3 || ft.norm() < 1e-9) continue;
+      worst = std::max(worst, std::acos(std::clamp(-ft.dot(st) / (ft.norm() * st.norm()), -1.0, 1.0)));
+    }
+    return worst;
   }
   double penetration() const {
     double p = 0;

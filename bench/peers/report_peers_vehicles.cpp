@@ -358,8 +358,9 @@ void skidTable(std::ostringstream& md, const std::vector<Row>& rows, std::ofstre
         "Yaw rate ÷ r(ω_R − ω_L)/track: how far the tyres slide (1 would be rolling).\n\n"
      << "| engine | setting | μ sliding | yaw rate 8–10 s [rad/s] | yaw rate 6–8 s | forward speed [m/s] | "
         "lateral speed [m/s] | turn radius [m] | ω_L, ω_R [rad/s] | yaw rate ÷ r(ω_R − ω_L)/track | "
-        "yaw rate vs closed form | CPU ms per simulated s: median (min–max) | steps | max penetration [m] |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "yaw rate vs closed form | CPU ms per simulated s: median (min–max) | steps | max penetration [m] | "
+        "tyres touching, 8–10 s (min–max) | friction ∠ −slip, max over 8–10 s |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     if (r.scene != "skid") continue;
     const double w = meanYawRate(r.last, 8, 10), w68 = meanYawRate(r.last, 6, 8);
@@ -372,11 +373,22 @@ void skidTable(std::ostringstream& md, const std::vector<Row>& rows, std::ofstre
       if (c.t >= 8 - 1e-9) wl += (c.wheel_rate[0] + c.wheel_rate[2]) / 2, wr += (c.wheel_rate[1] + c.wheel_rate[3]) / 2, ++n;
     wl /= std::max(n, 1);
     wr /= std::max(n, 1);
+    int touching_min = 4, touching_max = 0;
+    double angle = 0;
+    for (const ChassisSample& c : r.last.samples)
+      if (c.t >= 8 - 1e-9 && c.contacts >= 0) {
+        touching_min = std::min(touching_min, c.contacts);
+        touching_max = std::max(touching_max, c.contacts);
+        angle = std::max(angle, c.friction_angle);
+      }
+    const bool soft = r.engine == "mujoco";
     md << "| " << r.engine << " | " << r.setting << " | " << r.mu_slide << " | " << fixed(w, 4) << " | "
        << fixed(w68, 4) << " | " << fixed(fwd, 4) << " | " << fixed(lat, 4) << " | " << fixed(fwd / w, 3) << " | "
        << fixed(wl, 2) << ", " << fixed(wr, 2) << " | " << fixed(w / (rw * (wr - wl) / track), 3) << " | "
        << fixed(100 * diff, 1) << " % | " << cpuCell(r) << " | " << r.last.steps << " | "
-       << (r.engine == "mujoco" ? sci(r.last.max_penetration) : "") << " |"
+       << (soft ? sci(r.last.max_penetration) : "") << " | "
+       << (soft ? std::to_string(touching_min) + "–" + std::to_string(touching_max) : "") << " | "
+       << (soft ? fixed(angle * 180 / std::numbers::pi, 0) + "°" : "") << " |"
        << (r.last.ok ? "" : " failed: " + r.last.message) << "\n";
     csv << "skid," << r.engine << ",\"" << r.setting << "\"," << r.mu_slide << "," << w << "," << w68 << "," << fwd
         << "," << lat << ",,,," << 1e3 * r.perSimSecond() << "," << 1e3 * r.minCpu() << "," << 1e3 * r.maxCpu()

@@ -19,6 +19,7 @@
 #include "disk_problem.hpp"  // V3, cpuSeconds, median
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,11 @@ struct ChassisSample {
   V3 velocity = V3::Zero();
   V3 omega = V3::Zero();
   std::array<double, 4> wheel_rate{};  ///< wheel joint rates (rad/s), FL FR RL RR; 0 when locked
+  /// Soft-contact engines: tyres in contact, and the largest angle (rad)
+  /// between a sliding tyre's friction force and its slip's opposite
+  /// (Coulomb's law: 0); −1 / NaN where not measured.
+  int contacts = -1;
+  double friction_angle = std::numeric_limits<double>::quiet_NaN();
   /// Velocity of the link origin along the chassis' x axis (forward) and y.
   double forward() const { return velocity.dot(rotation.col(0)); }
   double lateral() const { return velocity.dot(rotation.col(1)); }
