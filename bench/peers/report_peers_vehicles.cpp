@@ -475,6 +475,25 @@ void header(std::ostringstream& md, int repeats, const std::string& out_dir, con
         "(every 0.1 s / 1 s) is outside the timed region; appell's adaptive steps end on those times (≈ 100 of its ≈ 2 300 steps on the skid-steer).\n\n";
 }
 
+/// Every sample of every row (peers_vehicles_trace.csv), and the MJCF of the
+/// elliptic rows as built.
+void writeTraceAndModels(const std::vector<Row>& rows, const std::string& out_dir) {
+  std::ofstream trace(out_dir + "/peers_vehicles_trace.csv");
+  trace << std::setprecision(9) << "scene,engine,setting,t,x,y,z,heading,yaw_rate,forward,lateral,w_fl,w_fr,w_rl,w_rr\n";
+  for (const Row& r : rows)
+    for (const ChassisSample& c : r.last.samples) {
+      trace << r.scene << "," << r.engine << ",\"" << r.setting << "\"," << c.t << "," << c.origin.x() << ","
+            << c.origin.y() << "," << c.origin.z() << "," << heading(c) << "," << c.omega.z() << "," << c.forward()
+            << "," << c.lateral();
+      for (double w : c.wheel_rate) trace << "," << w;
+      trace << "\n";
+    }
+  std::ofstream(out_dir + "/peers_vehicles_skid.xml")
+      << mujocoModelXml(skidSteerStep(), mj("elliptic, dt 1 ms", 0.8, 1e-3, "elliptic"));
+  std::ofstream(out_dir + "/peers_vehicles_car.xml")
+      << mujocoModelXml(parkedCar(kSlope), mj("elliptic, dt 2 ms", 0.9, 2e-3, "elliptic"));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -536,22 +555,7 @@ int main(int argc, char** argv) {
   md << "\nChecks:\n\n";
   for (const std::string& c : checks) md << "- " << c << "\n";
   md << "\n";
-  {
-    std::ofstream trace(out_dir + "/peers_vehicles_trace.csv");
-    trace << std::setprecision(9) << "scene,engine,setting,t,x,y,z,heading,yaw_rate,forward,lateral,w_fl,w_fr,w_rl,w_rr\n";
-    for (const Row& r : rows)
-      for (const ChassisSample& c : r.last.samples) {
-        trace << r.scene << "," << r.engine << ",\"" << r.setting << "\"," << c.t << "," << c.origin.x() << ","
-              << c.origin.y() << "," << c.origin.z() << "," << heading(c) << "," << c.omega.z() << ","
-              << c.forward() << "," << c.lateral();
-        for (double w : c.wheel_rate) trace << "," << w;
-        trace << "\n";
-      }
-  }
-  std::ofstream(out_dir + "/peers_vehicles_skid.xml")
-      << mujocoModelXml(skidSteerStep(), mj("elliptic, dt 1 ms", 0.8, 1e-3, "elliptic"));
-  std::ofstream(out_dir + "/peers_vehicles_car.xml")
-      << mujocoModelXml(parkedCar(kSlope), mj("elliptic, dt 2 ms", 0.9, 2e-3, "elliptic"));
+  writeTraceAndModels(rows, out_dir);
   md << "MJCF as built (elliptic rows): `peers_vehicles_skid.xml`, `peers_vehicles_car.xml`; raw numbers: "
         "`peers_vehicles.csv`; the chassis and wheel rates at every sample of every row: "
         "`peers_vehicles_trace.csv`.\n";
