@@ -470,8 +470,9 @@ void header(std::ostringstream& md, int repeats, const std::string& out_dir, con
      << repeats << " interleaved repeats (each repeat runs every row once, in table order); the physics columns are "
         "the last repeat's (every engine is deterministic).\n\n"
      << "Libraries: appell from this tree (`-O3 -DNDEBUG`, GCC 12); MuJoCo 2.2.2 = Debian `libmujoco-dev` "
-        "2.2.2-3 (Debian's build: `-O2` with the upstream CMake flags); Siconos 4.4.0 = Debian "
-        "`libsiconos-kernel-dev` 4.4.0+dfsg-2 (`-O2`, OpenBLAS, run with one BLAS thread). Sampling the chassis "
+        "2.2.2-3 and Siconos 4.4.0 = Debian `libsiconos-kernel-dev` 4.4.0+dfsg-2, both as Debian built them "
+        "(its default `dpkg-buildflags`, `-O2`; the packages do not record their exact flags); Siconos linked to "
+        "OpenBLAS, run with one BLAS thread. Sampling the chassis "
         "(every 0.1 s / 1 s) is outside the timed region; appell's adaptive steps end on those times (≈ 100 of its ≈ 2 300 steps on the skid-steer).\n\n";
 }
 
