@@ -42,6 +42,7 @@ declare -A ARGS=(
   [report_speed_error]="--repeats 3 --out $OUT $SPEED_SCENES"
   [report_long_run]="--steps 1000000 --dt 0.01 --out $OUT"
   [report_peers]="--repeats 3 --out $OUT"
+  [report_peers_vehicles]="--repeats 3 --out $OUT"
   [thread_scaling]="--repeat 5"
   [report_info_times]="--repeats 5 --out $OUT/info_times.md"
 )
@@ -51,6 +52,7 @@ run() {
   local name=$1 exe=build/bench/$1 start
   [ -n "${ARGS[$name]+x}" ] || { echo "bench.sh: no benchmark named '$name' (one of: ${!ARGS[*]})" >&2; return 2; }
   [ "$name" = report_peers ] && exe=build/bench/peers/report_peers
+  [ "$name" = report_peers_vehicles ] && exe=build/bench/peers/report_peers_vehicles
   [ "$name" = thread_scaling ] && exe=python/bench/thread_scaling.py
   [ "$name" = report_info_times ] && exe=bench/report_info_times.py
   [ -e "$exe" ] || { echo "bench.sh: $exe was not built" >&2; return 1; }
@@ -77,7 +79,7 @@ run() {
 }
 
 ALL=(bm_dynamics bm_evaluation bm_constrained_scaling bm_events bm_friction bm_collision bm_parallel
-     report_speed_error report_long_run report_peers thread_scaling report_info_times)
+     report_speed_error report_long_run report_peers report_peers_vehicles thread_scaling report_info_times)
 total_start=$(date +%s)
 for name in "${@:-${ALL[@]}}"; do run "$name"; done
 echo "bench.sh: all done in $(( $(date +%s) - total_start )) s; results in $OUT"
