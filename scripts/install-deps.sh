@@ -17,7 +17,6 @@ PACKAGES=(
   python3-numpy python3-pytest    # their arrays and their tests
   python3-pip python3-venv python3-setuptools python3-wheel  # pip install . (pyproject.toml)
   python3-distributed             # appell.sweep on a Dask cluster (python/appell/sweep.py)
-  clang                  # the compiler of scripts/test.sh (README, "Building")
 )
 
 bash "$(dirname "$0")/apt-install.sh" install-deps "${PACKAGES[@]}"
