@@ -10,20 +10,27 @@
 #   through the sanitizer's allocation hook), the simulator's failure paths
 #   and `appell run` end to end (4 programs, 5 min of the ~8 this takes on
 #   2 cores is the sanitized library). The whole suite: SANITIZE_ALL=1.
+#   scripts/sanitize.sh --build  only configure and build (the subset, `appell`
+#   and the two fuzz targets): scripts/test.sh runs this beside the Release
+#   build, at lower priority, then this script again for the runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 # test_failures: the files named in tests/CMakeLists.txt's group of that name.
 SUBSET=(test_failures test_core_allocations test_simulator_alloc test_tree_solver_alloc)
+FUZZERS=(fuzz_scene_loader fuzz_mesh_loader)
 bash scripts/configure-asan.sh
+# One ninja run for everything this script needs: the fuzz targets' sources
+# compile beside the tests' instead of after the test runs.
 if [ "${SANITIZE_ALL:-0}" = 1 ]; then
   cmake --build build-asan -j"$(nproc)"
   filter=()
 else
-  cmake --build build-asan -j"$(nproc)" --target "${SUBSET[@]}" appell_cli
+  cmake --build build-asan -j"$(nproc)" --target "${SUBSET[@]}" appell_cli "${FUZZERS[@]}"
   # Every test carries its executable's name as a label (tests/CMakeLists.txt).
   filter=(-L "^($(IFS='|'; echo "${SUBSET[*]}"))\$")
 fi
+[ "${1:-}" = --build ] && exit 0
 # Leaks inside third-party libraries are suppressed by name (fuzz/lsan.supp).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
@@ -36,7 +43,6 @@ seed=${FUZZ_SEED:-1}
 if [ "$seconds" != 0 ]; then
   # The scene loader and the mesh gate (every format assimp recognises by
   # content, under any name) at once, one per core: the 2×30 s take 30 s.
-  cmake --build build-asan -j"$(nproc)" --target fuzz_scene_loader fuzz_mesh_loader
   FUZZ_BUILT=1 bash scripts/fuzz.sh -max_total_time="$seconds" -seed="$seed" \
     > build-asan/fuzz_scene_loader.log 2>&1 &
   scene=$!

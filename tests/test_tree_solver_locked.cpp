@@ -192,7 +192,7 @@ TEST(LockedJoints, LimitsAreNotLoopRowsCouplingsAre) {
   ModelBuilder b;
   int parent = -1;
   for (int i = 0; i < 6; ++i)
-    parent = b.addBody("l" + std::to_string(i), parent, SE3(Mat3::Identity(), Vec3(0, 0, -0.2)),
+    parent = b.addBody("l" + std::to_string(i), parent, SE3{Mat3::Identity(), Vec3(0, 0, -0.2)},
                        JointType::Revolute, Vec3::UnitY(),
                        Inertia{1.0, Vec3(0, 0, -0.1), Vec3::Constant(0.01).asDiagonal()},
                        "j" + std::to_string(i));
