@@ -268,35 +268,3 @@ TEST(ContactTimeStepping, SkidSteerOnAStepCommandRunsToItsEnd) {
   EXPECT_LT(s.max_energy_deviation, 2e-2 * s.energy_scale)
       << "balance off by " << s.max_energy_deviation << " J of " << s.energy_scale;
 }
-
-// Protects the stall watchdog of the run loop: a watchdog that demands more
-// simulated time than any run gives (a fraction of 10⁹ of the wall time,
-// checked after every step) stops an event-scheme run with the report —
-// "the run stalled", the events per simulated second — while the automatic
-// scheme first opens a time-stepping window (logged), and stops only when
-// the window stalls too.
-TEST(ContactTimeStepping, StallWatchdogStopsOrSwitches) {
-  const Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) +
-                                "/examples/skid_steer_step/skid_steer_step.urdf");
-  RunOptions o = runOptions(scene.settings);
-  o.duration = 0.05;
-  o.watchdog_fraction = 1e9;
-  o.watchdog_interval = 1e-12;
-  o.contacts = ContactScheme::Events;
-  const RunSummary stopped = runScene(scene, o, RunObserver{});
-  ASSERT_FALSE(stopped.ok);
-  EXPECT_EQ(stopped.failure.rfind("the run stalled: it advanced ", 0), 0u) << stopped.failure;
-  EXPECT_NE(stopped.failure.find("contact events per simulated second"), std::string::npos)
-      << stopped.failure;
-  EXPECT_EQ(stopped.counters.windows, 0);
-  EXPECT_EQ(stopped.counters.steps, 1) << "stopped at the first check";
-  o.contacts = ContactScheme::Auto;
-  const RunSummary switched = runScene(scene, o, RunObserver{});
-  ASSERT_FALSE(switched.ok);
-  EXPECT_EQ(switched.failure.rfind("the run stalled: it advanced ", 0), 0u) << switched.failure;
-  EXPECT_EQ(switched.counters.windows, 1) << "the first stall opened a window";
-  EXPECT_EQ(switched.counters.timestepping_steps, 1) << "the window's first step stalled too";
-  ASSERT_FALSE(switched.events.empty());
-  EXPECT_EQ(switched.events.back().kind, ContactEventKind::TimeStepping);
-}
-

@@ -1,0 +1,135 @@
+// The automatic scheme's switches between events and time-stepping windows
+// (docs/contacts.md §10) on the done-when scene, the Ackermann CAD car
+// (examples/cad_car: one rear wheel 0.2 mm out of line, a steering step at
+// t = 2 s that makes every tyre slip): the work balance stays closed across
+// a window's close (the hand-back must not jump the state), the switch into
+// a window is decided by counts (two runs give the same CSV byte for byte),
+// and the wall-clock watchdog only stops runs.
+#include <gtest/gtest.h>
+
+#include <appell/output.hpp>
+#include <appell/run.hpp>
+#include <appell/simulator.hpp>
+#include <appell/urdf.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+using namespace appell;
+
+namespace {
+
+const std::string kCadCar = std::string(APPELL_SOURCE_DIR) + "/examples/cad_car/cad_car.urdf";
+
+/// The work balance D = E + losses − work in, less its value at t = 0.
+struct Balance {
+  double d0 = 0;
+  bool started = false;
+  double operator()(const Simulator& s) const {
+    return s.energy() + s.impactEnergyLoss() + s.frictionWork() - s.jointWork() - s.supportWork() - d0;
+  }
+};
+
+}  // namespace
+
+// Protects the hand-back from a window to the events. At the first window's
+// minimum length the events decided all four tyres sticking, which the car's
+// offset rear wheels allow only at rest while it steers: the next event
+// step's drift projection then took the car's 11 J of kinetic energy away
+// and the divergence watch stopped the run (exit 3 at t = 2.10 s). Now the
+// window closes only at a state the decided modes hold: across every step —
+// a window's close included — the balance moves by no more than the
+// scheme's O(h) per step, and the run reaches its end.
+TEST(WindowSwitch, CadCarKeepsItsWorkBalanceAcrossAWindowsClose) {
+  const Scene scene = loadScene(kCadCar);
+  RunOptions o = runOptions(scene.settings);
+  EXPECT_EQ(o.contacts, ContactScheme::Auto);
+  o.duration = 3.0;
+  o.watchdog_fraction = 0;  // (a loaded machine's wall clock must not stop it)
+  Balance balance;
+  double last = 0, largest_jump = 0, jump_t = -1;
+  ContactScheme previous = ContactScheme::Events;
+  int closes = 0;
+  const RunSummary s = runScene(scene, o, RunObserver{}, [&](const Simulator& sim) {
+    if (!balance.started) {
+      balance.d0 = balance(sim);
+      balance.started = true;
+    }
+    const double d = balance(sim);
+    if (std::abs(d - last) > largest_jump) {
+      largest_jump = std::abs(d - last);
+      jump_t = sim.time();
+    }
+    last = d;
+    closes += previous == ContactScheme::TimeStepping && sim.stepScheme() == ContactScheme::Events;
+    previous = sim.stepScheme();
+  });
+  ASSERT_TRUE(s.ok) << s.failure;
+  EXPECT_NEAR(s.time, 3.0, 1e-12);
+  EXPECT_GE(s.counters.windows, 1) << "the steering step opens a window";
+  EXPECT_GT(s.joint_work, 10.0) << "the motors drive the car";
+  // Measured: 1.5e-5 of the energy that moved over a window (O(h)); the
+  // hand-back's jump was 11.2 J, 0.99 of it.
+  EXPECT_LT(s.relativeEnergyDeviation(), 1e-3) << s.max_energy_deviation << " J";
+  EXPECT_LT(largest_jump, 1e-3 * s.energy_scale) << "at t = " << jump_t << " (" << closes
+                                                 << " window closes)";
+}
+
+// Protects the automatic scheme's stall rule: the CAD car with the exact
+// sliding law throughout (settle_time 0) stalls under the events at its
+// first slip — its steps collapse — and the automatic scheme opens a window
+// there after stall_evaluations evaluations that advance less than
+// stall_time, whatever the machine's load: two runs of one binary write the
+// same CSV byte for byte.
+TEST(WindowSwitch, StallRuleOpensAWindowDeterministically) {
+  const Scene scene = loadScene(kCadCar);
+  RunOptions o = runOptions(scene.settings);
+  o.settle_time = 0;
+  o.duration = 0.1;
+  o.watchdog_fraction = 0;  // (a loaded machine's wall clock must not stop it first)
+  std::string csv[2], reason[2];
+  RunSummary s[2];
+  for (int i = 0; i < 2; ++i) {
+    std::ostringstream out;
+    TrajectoryWriter writer(out, scene);
+    long windows = 0;
+    s[i] = runScene(scene, o, writer, [&](const Simulator& sim) {
+      if (sim.counters().windows > windows && reason[i].empty()) reason[i] = sim.windowReason();
+      windows = sim.counters().windows;
+    });
+    csv[i] = out.str();
+  }
+  ASSERT_TRUE(s[0].ok) << s[0].failure;
+  EXPECT_GE(s[0].counters.windows, 1);
+  EXPECT_EQ(reason[0].rfind("the steps stalled: ", 0), 0u) << reason[0];
+  EXPECT_EQ(reason[0], reason[1]);
+  EXPECT_GT(csv[0].size(), 1000u);
+  EXPECT_TRUE(csv[0] == csv[1]) << "two runs of one binary differ";
+}
+
+// Protects the stall watchdog of the run loop: a watchdog that demands more
+// simulated time than any run gives (a fraction of 10⁹ of the wall time,
+// checked after every step) stops the run with the report — "the run
+// stalled", the events per simulated second — under every scheme: the wall
+// clock never switches the scheme (a trajectory must not depend on the
+// machine's load), the simulator's own stall rule does (above).
+TEST(WindowSwitch, StallWatchdogStopsTheRun) {
+  const Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) +
+                                "/examples/skid_steer_step/skid_steer_step.urdf");
+  RunOptions o = runOptions(scene.settings);
+  o.duration = 0.05;
+  o.watchdog_fraction = 1e9;
+  o.watchdog_interval = 1e-12;
+  for (ContactScheme c : {ContactScheme::Events, ContactScheme::Auto}) {
+    SCOPED_TRACE(toString(c));
+    o.contacts = c;
+    const RunSummary stopped = runScene(scene, o, RunObserver{});
+    ASSERT_FALSE(stopped.ok);
+    EXPECT_EQ(stopped.failure.rfind("the run stalled: it advanced ", 0), 0u) << stopped.failure;
+    EXPECT_NE(stopped.failure.find("contact events per simulated second"), std::string::npos)
+        << stopped.failure;
+    EXPECT_EQ(stopped.counters.windows, 0) << "the wall clock opens no window";
+    EXPECT_EQ(stopped.counters.steps, 1) << "stopped at the first check";
+  }
+}
