@@ -12,7 +12,9 @@
 #include <appell/simulator.hpp>
 #include <appell/urdf.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -74,6 +76,50 @@ TEST(WindowSwitch, CadCarKeepsItsWorkBalanceAcrossAWindowsClose) {
   EXPECT_LT(s.relativeEnergyDeviation(), 1e-3) << s.max_energy_deviation << " J";
   EXPECT_LT(largest_jump, 1e-3 * s.energy_scale) << "at t = " << jump_t << " (" << closes
                                                  << " window closes)";
+}
+
+// Protects the hand-back at the state where it went wrong: the window
+// opened where the wall-clock watchdog opened it before 2026-11-27
+// (t = 2.00150346173 s, in the stall of the steering step), and the car
+// driven on to t = 2.3 s. Every step — a window's close included — moves the
+// balance by less than 1e-3 of the energy that moved (the jump was 11.2 J).
+TEST(WindowSwitch, CadCarHandBackAfterAWindowOpenedInTheStall) {
+  const Scene scene = loadScene(kCadCar);
+  RunOptions o = runOptions(scene.settings);
+  std::unique_ptr<Simulator> sim = makeSimulator(scene, o);
+  Balance balance;
+  balance.d0 = balance(*sim);
+  double h = o.dt, last = 0, largest_jump = 0, jump_t = -1, scale = 1e-12;
+  bool ok = true;
+  int closes = 0;
+  std::string failure;
+  auto stepTo = [&](double T) {
+    while (ok && sim->time() < T - 1e-12) {
+      const ContactScheme before = sim->stepScheme();
+      const StepStatus st = sim->step(std::min(h, T - sim->time()));
+      if (!st.ok) {
+        ok = false;
+        failure = st.message;
+        return;
+      }
+      h = st.h_next > 0 ? st.h_next : h;
+      closes += before == ContactScheme::TimeStepping && sim->stepScheme() == ContactScheme::Events;
+      const double d = balance(*sim);
+      if (std::abs(d - last) > largest_jump) {
+        largest_jump = std::abs(d - last);
+        jump_t = sim->time();
+      }
+      last = d;
+      scale = std::max({scale, sim->kineticEnergy(), std::abs(sim->jointWork())});
+    }
+  };
+  stepTo(2.00150346173);
+  ASSERT_TRUE(ok) << failure;
+  ASSERT_TRUE(sim->openTimeSteppingWindow("opened by the test where the watchdog opened it"));
+  stepTo(2.3);
+  ASSERT_TRUE(ok) << failure;
+  EXPECT_LT(largest_jump, 1e-3 * scale) << "at t = " << jump_t << " (" << closes << " window closes)";
+  EXPECT_LT(std::abs(last), 1e-3 * scale) << "balance off at t = 2.3 s";
 }
 
 // Protects the automatic scheme's stall rule: the CAD car with the exact
