@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -115,24 +116,26 @@ TEST(WindowSwitch, CadCarHandBackAfterAWindowOpenedInTheStall) {
   };
   stepTo(2.00150346173);
   ASSERT_TRUE(ok) << failure;
-  ASSERT_TRUE(sim->openTimeSteppingWindow("opened by the test where the watchdog opened it"));
+  if (sim->stepScheme() == ContactScheme::Events)  // (else the stall rule opened one already)
+    ASSERT_TRUE(sim->openTimeSteppingWindow("opened by the test where the watchdog opened it"));
   stepTo(2.3);
   ASSERT_TRUE(ok) << failure;
+  std::cout << closes << " window closes, largest step in the balance " << largest_jump << " J at t = "
+            << jump_t << " s of " << scale << " J\n";
   EXPECT_LT(largest_jump, 1e-3 * scale) << "at t = " << jump_t << " (" << closes << " window closes)";
   EXPECT_LT(std::abs(last), 1e-3 * scale) << "balance off at t = 2.3 s";
 }
 
-// Protects the automatic scheme's stall rule: the CAD car with the exact
-// sliding law throughout (settle_time 0) stalls under the events at its
-// first slip — its steps collapse — and the automatic scheme opens a window
-// there after stall_evaluations evaluations that advance less than
-// stall_time, whatever the machine's load: two runs of one binary write the
-// same CSV byte for byte.
+// Protects the automatic scheme's stall rule: at the CAD car's steering
+// step (t = 2 s) every tyre slips, rear_right_tyre chatters and the event
+// steps collapse with no further event (no Zeno) — and the automatic scheme
+// opens a window there after stall_evaluations evaluations that advance less
+// than stall_time, whatever the machine's load: two runs of one binary write
+// the same CSV byte for byte.
 TEST(WindowSwitch, StallRuleOpensAWindowDeterministically) {
   const Scene scene = loadScene(kCadCar);
   RunOptions o = runOptions(scene.settings);
-  o.settle_time = 0;
-  o.duration = 0.1;
+  o.duration = 2.05;
   o.watchdog_fraction = 0;  // (a loaded machine's wall clock must not stop it first)
   std::string csv[2], reason[2];
   RunSummary s[2];

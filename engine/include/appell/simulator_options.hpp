@@ -48,7 +48,7 @@ struct TimeSteppingOptions {
   /// state on any machine under any load (the wall clock only stops a run:
   /// RunOptions::watchdog_fraction).
   long stall_evaluations = 5000;
-  double stall_time = 1e-4;
+  double stall_time = 1e-5;
   // … and when it ends: at least min_window (s, doubled each time the events
   // fail again within a window's length of its end), the contact modes
   // unchanged over stable_steps steps, and the event scheme's modes decided.
