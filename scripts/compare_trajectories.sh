@@ -12,9 +12,9 @@
 # many times). Exit status 1 when any scene differs.
 #
 # A run the stall watchdog stops (run/src/stall_watch.cpp: wall-clock time)
-# is not reproducible even with one CLI — examples/cad_car at its own 6 s
-# differs between two runs of the same binary after t ≈ 2 s; compare it
-# with a DURATION below its stall.
+# ends where the machine's load let it get. The automatic scheme's switch to
+# time-stepping no longer depends on the wall clock (docs/contacts.md §10:
+# it counts evaluations), so a run that finishes is reproducible bit for bit.
 set -u
 abs() { [ "$1" = - ] && echo - || echo "$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"; }
 base=$(abs "$1")

@@ -81,7 +81,14 @@ TEST(ContactFriction, PushedBallSlipsWhenTheDemandReachesMu) {
   for (Formulation f : {Formulation::Tree, Formulation::Multipliers, Formulation::Appell}) {
     for (IntegratorType it : {IntegratorType::DormandPrince54}) {
       BuiltScene s = ballWithFriction(mu, Vec3::Zero(), Vec3::Zero(), Vec3(0, 0, -kG));
-      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it, appell::test::tightIntegrator());
+      // The events' exactness is what is checked: at this tolerance (1e-13)
+      // the steps after the slip take 5 000 evaluations within 10 µs, which the
+      // automatic scheme's stall rule takes for a stall (docs/contacts.md §10,
+      // a known limit) — so it is off here.
+      SimulatorOptions so;
+      so.timestepping.stall_evaluations = std::numeric_limits<long>::max();
+      Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it,
+                    appell::test::tightIntegrator(), so);
       sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
         tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
       });

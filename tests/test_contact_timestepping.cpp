@@ -88,7 +88,9 @@ TEST(ContactTimeStepping, BoxPushedToSlidingOnFourCorners) {
               << "largest residual " << sim.counters().max_contact_residual << " m/s\n";
     EXPECT_LT(sim.counters().unconverged, 10);
     EXPECT_LT(sim.counters().max_contact_residual, 1e-5) << "m/s";
-    EXPECT_NEAR(t_slip, t_star, 2 * h) << "slip starts where F reaches μ m g";
+    // (Within two steps; t is a sum of steps, so the bound allows its round-off:
+    // at h = 0.5 ms the slip shows at t* + 2h, 2e-16 s past 2h.)
+    EXPECT_NEAR(t_slip, t_star, 2 * h + 1e-12) << "slip starts where F reaches μ m g";
     const double v = k * (T - t_star) * (T - t_star) / (2 * kMass);
     errors[run++] = std::abs(worldLinear(sim).x() - v);
     EXPECT_LT(errors[run - 1], 10 * h * k / kMass * (T - t_star)) << worldLinear(sim).x() << " vs " << v;
@@ -268,35 +270,3 @@ TEST(ContactTimeStepping, SkidSteerOnAStepCommandRunsToItsEnd) {
   EXPECT_LT(s.max_energy_deviation, 2e-2 * s.energy_scale)
       << "balance off by " << s.max_energy_deviation << " J of " << s.energy_scale;
 }
-
-// Protects the stall watchdog of the run loop: a watchdog that demands more
-// simulated time than any run gives (a fraction of 10⁹ of the wall time,
-// checked after every step) stops an event-scheme run with the report —
-// "the run stalled", the events per simulated second — while the automatic
-// scheme first opens a time-stepping window (logged), and stops only when
-// the window stalls too.
-TEST(ContactTimeStepping, StallWatchdogStopsOrSwitches) {
-  const Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) +
-                                "/examples/skid_steer_step/skid_steer_step.urdf");
-  RunOptions o = runOptions(scene.settings);
-  o.duration = 0.05;
-  o.watchdog_fraction = 1e9;
-  o.watchdog_interval = 1e-12;
-  o.contacts = ContactScheme::Events;
-  const RunSummary stopped = runScene(scene, o, RunObserver{});
-  ASSERT_FALSE(stopped.ok);
-  EXPECT_EQ(stopped.failure.rfind("the run stalled: it advanced ", 0), 0u) << stopped.failure;
-  EXPECT_NE(stopped.failure.find("contact events per simulated second"), std::string::npos)
-      << stopped.failure;
-  EXPECT_EQ(stopped.counters.windows, 0);
-  EXPECT_EQ(stopped.counters.steps, 1) << "stopped at the first check";
-  o.contacts = ContactScheme::Auto;
-  const RunSummary switched = runScene(scene, o, RunObserver{});
-  ASSERT_FALSE(switched.ok);
-  EXPECT_EQ(switched.failure.rfind("the run stalled: it advanced ", 0), 0u) << switched.failure;
-  EXPECT_EQ(switched.counters.windows, 1) << "the first stall opened a window";
-  EXPECT_EQ(switched.counters.timestepping_steps, 1) << "the window's first step stalled too";
-  ASSERT_FALSE(switched.events.empty());
-  EXPECT_EQ(switched.events.back().kind, ContactEventKind::TimeStepping);
-}
-

@@ -1,6 +1,8 @@
 // The stall watchdog (stall_watch.hpp).
 #include "stall_watch.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <set>
 #include <sstream>
@@ -8,21 +10,27 @@
 namespace appell::run_detail {
 
 StallWatch::StallWatch(double fraction, double interval, double t0, std::size_t events0)
-    : fraction_(fraction), interval_(interval), start_(Clock::now()), t_start_(t0),
+    : fraction_(fraction), interval_(interval), start_(cpuSeconds()), t_start_(t0),
       events_start_(events0) {}
+
+double StallWatch::cpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 bool StallWatch::stalled(double t, std::size_t events) {
   if (!(fraction_ > 0) || !(interval_ > 0)) return false;
-  const Clock::time_point now = Clock::now();
-  const double wall = std::chrono::duration<double>(now - start_).count();
-  if (wall < interval_) return false;
+  const double now = cpuSeconds();
+  const double cpu = now - start_;
+  if (cpu < interval_) return false;
   sim_span_ = t - t_start_;
-  wall_span_ = wall;
+  cpu_span_ = cpu;
   events_span_begin_ = events_start_;
   start_ = now;
   t_start_ = t;
   events_start_ = events;
-  return sim_span_ < fraction_ * wall;
+  return sim_span_ < fraction_ * cpu;
 }
 
 std::string StallWatch::report(const RunSummary& s) const {
@@ -30,8 +38,8 @@ std::string StallWatch::report(const RunSummary& s) const {
   out.precision(3);
   const std::size_t first = std::min(events_span_begin_, s.events.size());
   const std::size_t count = s.events.size() - first;
-  out << "the run stalled: it advanced " << sim_span_ << " s of simulated time in " << wall_span_
-      << " s of wall time (less than the watchdog's " << fraction_ << " of it) up to t = "
+  out << "the run stalled: it advanced " << sim_span_ << " s of simulated time in " << cpu_span_
+      << " s of CPU time (less than the watchdog's " << fraction_ << " of it) up to t = "
       << s.time << " s; " << (sim_span_ > 0 ? count / sim_span_ : 0.0)
       << " contact events per simulated second";
   std::set<std::string> names;

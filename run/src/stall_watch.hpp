@@ -1,16 +1,19 @@
 // The run loop's stall watchdog (RunOptions::watchdog_fraction): over every
-// stretch of `interval` seconds of wall time the simulated time must advance
+// stretch of `interval` seconds of the run's CPU time (the calling thread's:
+// a machine busy with other work does not count against the run, and
+// parallel sweeps each keep their own) the simulated time must advance
 // by at least `fraction` of it. A run that does not — steps collapsing at a
 // contact that cannot decide its mode, thousands of events per simulated
-// millisecond — is either switched to time-stepping (the automatic scheme)
-// or stopped with a report that names what it was doing: the contacts that
-// changed mode in that stretch, the events per simulated second and the last
-// mode changes.
+// millisecond — is stopped with a report that names what it was doing: the
+// contacts that changed mode in that stretch, the events per simulated
+// second and the last mode changes. It only stops runs: the automatic
+// scheme's switch to time-stepping is decided inside the simulator by
+// counts of evaluations (TimeSteppingOptions::stall_evaluations), so that a
+// trajectory does not depend on the machine's load.
 #pragma once
 
 #include <appell/run.hpp>
 
-#include <chrono>
 #include <string>
 
 namespace appell::run_detail {
@@ -22,16 +25,16 @@ class StallWatch {
   /// true when the stretch that just ended advanced too little (then
   /// report() describes it). Starts a new stretch at each check.
   bool stalled(double t, std::size_t events);
-  /// "the run advanced … s of simulated time in … s of wall time (…); N
+  /// "the run advanced … s of simulated time in … s of CPU time (…); N
   /// events per simulated second; contacts changing mode: …; last mode
   /// changes: …" from the summary's events of the stretch.
   std::string report(const RunSummary& s) const;
 
  private:
-  using Clock = std::chrono::steady_clock;
+  static double cpuSeconds();  ///< this thread's CPU time
   double fraction_, interval_;
-  Clock::time_point start_;
-  double t_start_, sim_span_ = 0, wall_span_ = 0;
+  double start_;
+  double t_start_, sim_span_ = 0, cpu_span_ = 0;
   std::size_t events_start_, events_span_begin_ = 0;
 };
 

@@ -41,8 +41,14 @@ struct TimeSteppingOptions {
   // auto: when a window starts …
   int zeno_events = 64;      ///< … this many events within zeno_time (s) of simulated time
   double zeno_time = 1e-2;
-  int collapse_steps = 200;  ///< … or that many steps advance less than collapse_step each on average
-  double collapse_step = 1e-7;
+  /// … or when stall_evaluations dynamics evaluations of the event scheme
+  /// (every stage, rejected steps and event location included) advance the
+  /// simulated time by less than stall_time (s): a stall decided by counts
+  /// of the simulation's own work, so the same run switches at the same
+  /// state on any machine under any load (the wall clock only stops a run:
+  /// RunOptions::watchdog_fraction).
+  long stall_evaluations = 5000;
+  double stall_time = 1e-5;
   // … and when it ends: at least min_window (s, doubled each time the events
   // fail again within a window's length of its end), the contact modes
   // unchanged over stable_steps steps, and the event scheme's modes decided.
@@ -106,6 +112,10 @@ struct SimulatorCounters {
   long unconverged = 0;
   double max_contact_residual = 0;
   double max_contact_gap = 0;
+  /// Block Gauss–Seidel sweeps over all those contact problems, and the
+  /// problems an active-set solve finished (docs/contacts.md §10).
+  long contact_sweeps = 0;
+  long contact_polished = 0;
 };
 
 }  // namespace appell

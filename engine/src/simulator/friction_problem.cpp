@@ -21,13 +21,25 @@ using detail::UnilateralRow;
 /// circle (bisection on the monotone |f(ν)|).
 Vec3 detail::diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
   if (!(r > 0)) return Vec3::Zero();
+  return diskMinimizer(factorDisk(H, n), c, n, r);
+}
+
+detail::DiskFactor detail::factorDisk(const Mat3& H, int n) {
   Mat3 Hp = Mat3::Identity();
   Hp.topLeftCorner(n, n) = H.topLeftCorner(n, n);
+  Eigen::SelfAdjointEigenSolver<Mat3> es(Hp);
+  DiskFactor f;
+  f.vectors = es.eigenvectors();
+  f.values = es.eigenvalues().cwiseMax(0.0);
+  return f;
+}
+
+Vec3 detail::diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r) {
+  if (!(r > 0)) return Vec3::Zero();
   Vec3 cp = Vec3::Zero();
   cp.head(n) = c.head(n);
-  Eigen::SelfAdjointEigenSolver<Mat3> es(Hp);
-  const Vec3 lam = es.eigenvalues().cwiseMax(0.0);
-  const Vec3 cq = es.eigenvectors().transpose() * cp;
+  const Vec3& lam = H.values;
+  const Vec3 cq = H.vectors.transpose() * cp;
   const double tiny = 1e-12 * std::max(lam.maxCoeff(), 1e-300);
   // The minimum-norm unconstrained minimizer exists when c has no part in
   // H's null space.
@@ -38,7 +50,7 @@ Vec3 detail::diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
     else if (std::abs(cq[i]) > 1e-14 * (cq.norm() + 1e-300)) bounded = false;
   }
   if (bounded && fq.norm() <= r) {
-    Vec3 f = es.eigenvectors() * fq;
+    Vec3 f = H.vectors * fq;
     f.tail(3 - n).setZero();
     return f;
   }
@@ -53,7 +65,7 @@ Vec3 detail::diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
     (radius(mid) > r ? lo : hi) = mid;
   }
   for (int i = 0; i < 3; ++i) fq[i] = -cq[i] / (lam[i] + hi);
-  Vec3 f = es.eigenvectors() * fq;
+  Vec3 f = H.vectors * fq;
   f.tail(3 - n).setZero();
   return f;
 }

@@ -76,4 +76,15 @@ struct FrictionProblem {
 /// symmetric positive semidefinite (friction_problem.cpp).
 Vec3 diskMinimizer(const Mat3& H, const Vec3& c, int n, double r);
 
+/// H's eigen-decomposition as diskMinimizer uses it (H padded with the
+/// identity beyond n, eigenvalues clamped at 0): computed once where H is
+/// fixed and many c are tried (the time-stepping Gauss–Seidel's blocks).
+struct DiskFactor {
+  Mat3 vectors = Mat3::Identity();
+  Vec3 values = Vec3::Ones();
+};
+DiskFactor factorDisk(const Mat3& H, int n);
+/// diskMinimizer(H, c, n, r) from H's factor: the same arithmetic.
+Vec3 diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r);
+
 }  // namespace appell::detail

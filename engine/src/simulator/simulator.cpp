@@ -54,7 +54,6 @@ Simulator::Impl::Impl(const Model& model, ConstraintList constraints,
     timeSteppingStage();
   last_modes_.assign(constraints_.size(), 0);
   event_ring_.assign(options_.timestepping.zeno_events, 0.0);
-  step_ring_.assign(options_.timestepping.collapse_steps, 0.0);
   window_min_ = options_.timestepping.min_window;
   // Size every per-step buffer of the field and the solver once, here.
   std::string ignored;
@@ -92,7 +91,7 @@ bool Simulator::Impl::setState(double t, const VecX& q, const VecX& v) {
     if (!decideContactModes(state_error_)) state_error_ = "initial contact modes: " + state_error_;
     // Modes the events cannot decide: time-stepping decides them (auto), or
     // is the scheme anyway.
-    event_count_ = step_count_ = 0;
+    restartStallWatch();
     stepping_ = options_.scheme == ContactScheme::TimeStepping && timeSteppingStage();
     window_closed_once_ = false;
     window_min_ = options_.timestepping.min_window;
@@ -248,7 +247,7 @@ StepStatus Simulator::Impl::step(double h) {
       openWindow(namedContact(st.message), st.message);
       return timeSteppingStep(h);
     }
-    watchEvents(st);
+    watchEvents();
   }
   return st;
 }

@@ -119,7 +119,9 @@ struct Simulator::Impl {
   bool timeSteppingStage();
   static constexpr double kEagerTimeSteppingDoubles = 1e7;  ///< 80 MB: built at construction
   bool closeWindow();
-  void watchEvents(const StepStatus& st);
+  void watchEvents();
+  /// Starts the Zeno and stall watches' counts afresh from the current state.
+  void restartStallWatch();
   int namedContact(const std::string& message) const;
   bool restepTo(double tau, StepStatus& st);
   /// work_ after an integrator step from the last step's start.
@@ -186,8 +188,12 @@ struct Simulator::Impl {
   int stable_ = 0;
   int window_contact_ = -1;  // a window to log at the next step (its contact), or −1
   std::vector<signed char> last_modes_;
-  std::vector<double> event_ring_, step_ring_;
-  long event_count_ = 0, step_count_ = 0;
+  std::vector<double> event_ring_;
+  long event_count_ = 0;
+  int last_event_contact_ = -1;  // the constraint of the last mode change (events)
+  // The stall watch's stretch: where it began (time, evaluations so far).
+  double stall_t0_ = 0;
+  long stall_evaluations0_ = 0;
   std::string window_reason_;
 };
 

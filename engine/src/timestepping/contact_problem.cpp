@@ -1,10 +1,7 @@
-// Non-smooth block Gauss–Seidel on the Moreau–Jean contact problem
-// (contact_problem.hpp states the problem and the residual).
+// Non-smooth block Gauss–Seidel on the Moreau–Jean contact problem, with
+// its active-set finish (contact_problem.hpp states the problem, the
+// residual and the finish).
 #include "timestepping/contact_problem.hpp"
-
-#include "simulator/friction_problem.hpp"
-
-#include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +11,6 @@ namespace appell::timestepping {
 namespace {
 
 using Vec6d = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
-using Mat6d = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 
 /// Π onto {|z_f| ≤ μ z_n} (Euclidean), z = (z_n, z_f) with nf friction parts.
 Vec3 projectOntoCone(double zn, const Vec3& zf, double mu, Vec3& out_f) {
@@ -38,6 +34,15 @@ void ContactProblem::reserve(int rows, int contacts) {
   W = MatX::Zero(rows, rows);
   u_free = target = P = u = VecX::Zero(rows);
   blocks.reserve(contacts);
+  disk_.resize(contacts);
+  ldlt_.resize(contacts);
+  stick_solve_.resize(contacts);
+  unknown_row_.reserve(rows);
+  unknown_block_.reserve(rows);
+  mode_.reserve(contacts);
+  dir_.resize(contacts);
+  A_ = B_ = MatX::Zero(rows, rows);
+  x_ = r_ = y_ = P_save_ = u_save_ = VecX::Zero(rows);
 }
 
 int ContactProblem::add(int nf, int ne, double mu) {
@@ -51,9 +56,31 @@ int ContactProblem::add(int nf, int ne, double mu) {
   return b.first;
 }
 
-// Block b exactly, the others' impulses fixed: c = its velocity without
+// Each block's own matrix, fixed while the others' impulses change: the
+// friction disk's eigen-decomposition and the equality rows' LDLᵀ, once.
+void ContactProblem::factorBlocks() {
+  for (int j = 0; j < static_cast<int>(blocks.size()); ++j) {
+    const ProblemBlock& b = blocks[j];
+    const int o = b.first, d = b.rows();
+    // The whole block's LDLᵀ: the equality rows' solve, and a friction
+    // block's sticking solve (used when W_bb is safely positive definite).
+    ldlt_[j].compute(W.block(o, o, d, d));
+    const auto D = ldlt_[j].vectorD();
+    stick_solve_[j] = b.nf > 0 && ldlt_[j].info() == Eigen::Success &&
+                      D.minCoeff() > 1e-10 * std::max(D.maxCoeff(), 1e-300);
+    if (b.nf > 0) {
+      Mat3 H = Mat3::Zero();
+      H.topLeftCorner(b.nf, b.nf) = W.block(o + 1, o + 1, b.nf, b.nf);
+      H = (0.5 * (H + H.transpose())).eval();
+      disk_[j] = detail::factorDisk(H, b.nf);
+    }
+  }
+}
+
+// Block j exactly, the others' impulses fixed: c = its velocity without
 // its own impulse.
-void ContactProblem::solveBlock(const ProblemBlock& b) {
+void ContactProblem::solveBlock(int j) {
+  const ProblemBlock& b = blocks[j];
   const int o = b.first, d = b.rows();
   Vec6d c = u_free.segment(o, d);
   c.noalias() += W.middleRows(o, d).leftCols(n) * P.head(n);
@@ -65,9 +92,7 @@ void ContactProblem::solveBlock(const ProblemBlock& b) {
   }
   if (b.ne > 0) {  // equalities while it pushes
     Vec6d rhs = target.segment(o, d) - c;
-    Mat6d Wb = W.block(o, o, d, d);
-    Eigen::LDLT<Mat6d> ldlt(Wb);
-    Vec6d x = ldlt.solve(rhs);
+    Vec6d x = ldlt_[j].solve(rhs);
     if (x.allFinite() && x[0] >= 0) P.segment(o, d) = x;
     else P.segment(o, d).setZero();
     return;
@@ -76,14 +101,23 @@ void ContactProblem::solveBlock(const ProblemBlock& b) {
     P[o] = std::max(0.0, (target[o] - c[0]) / wnn);
     return;
   }
-  // Normal row and friction disk, alternated to their fixed point.
   const int nf = b.nf;
-  Mat3 H = Mat3::Zero();
-  H.topLeftCorner(nf, nf) = W.block(o + 1, o + 1, nf, nf);
-  H = (0.5 * (H + H.transpose())).eval();
+  if (stick_solve_[j]) {
+    // Sticking: u_b = target_b exactly, when that impulse lies in the cone.
+    const Vec6d x = ldlt_[j].solve(target.segment(o, d) - c);
+    Vec3 xf = Vec3::Zero();  // (a fixed-size copy: GCC misreads a 6-capacity segment's norm)
+    xf.head(nf) = x.segment(1, nf);
+    if (x[0] >= 0 && xf.norm() <= b.mu * x[0]) {
+      P.segment(o, d) = x;
+      return;
+    }
+  }
+  // Sliding (or W_bb near singular): normal row and friction disk,
+  // alternated to their fixed point.
   double pn = P[o];
   Vec3 pf = Vec3::Zero();
   pf.head(nf) = P.segment(o + 1, nf);
+  const double hff = W(o + 1, o + 1);
   for (int it = 0; it < 100; ++it) {
     const double pn_old = pn;
     const Vec3 pf_old = pf;
@@ -92,10 +126,9 @@ void ContactProblem::solveBlock(const ProblemBlock& b) {
     cf.head(nf) = c.segment(1, nf) + W.col(o).segment(o + 1, nf) * pn;
     const double radius = b.mu * pn;
     if (nf == 1) {
-      pf[0] = H(0, 0) > 0 ? std::clamp(-cf[0] / H(0, 0), -radius, radius)
-                          : (cf[0] > 0 ? -radius : radius);
+      pf[0] = hff > 0 ? std::clamp(-cf[0] / hff, -radius, radius) : (cf[0] > 0 ? -radius : radius);
     } else {
-      pf = detail::diskMinimizer(H, cf, nf, radius);
+      pf = detail::diskMinimizer(disk_[j], cf, nf, radius);
     }
     const double change = std::abs(pn - pn_old) + (pf - pf_old).norm();
     if (change <= 1e-15 * (std::abs(pn) + pf.norm()) || change == 0) break;
@@ -128,22 +161,245 @@ double ContactProblem::blockResidual(const ProblemBlock& b) const {
   return std::sqrt(dn * dn + (pf - proj_f).squaredNorm()) / rho;
 }
 
+void ContactProblem::sweep() {
+  for (int j = 0; j < static_cast<int>(blocks.size()); ++j) solveBlock(j);
+  u.head(n) = u_free.head(n);
+  u.head(n).noalias() += W.topLeftCorner(n, n) * P.head(n);
+}
+
+double ContactProblem::maxResidual() const {
+  double r = 0;
+  for (const ProblemBlock& b : blocks) r = std::max(r, blockResidual(b));
+  return r;
+}
+
+// Gauss–Seidel sweeps, with the active-set finish tried from the second
+// sweep on (each try costs about one sweep: an m × m Cholesky, m ≤ n) — at
+// every sweep for the first 20 sweeps, then at every 10th.
 void ContactProblem::solve(double tol, int max_sweeps) {
   sweeps = 0;
   residual = 0;
   converged = true;
+  polished = false;
   if (n == 0) return;
+  factorBlocks();
   const double scale = std::max(1.0, u_free.head(n).lpNorm<Eigen::Infinity>());
   for (sweeps = 1; sweeps <= max_sweeps; ++sweeps) {
-    for (const ProblemBlock& b : blocks) solveBlock(b);
-    u.head(n) = u_free.head(n);
-    u.head(n).noalias() += W.topLeftCorner(n, n) * P.head(n);
-    residual = 0;
-    for (const ProblemBlock& b : blocks) residual = std::max(residual, blockResidual(b));
+    sweep();
+    residual = maxResidual();
     if (residual <= tol * scale) return;
+    if (sweeps >= 2 && (sweeps <= 20 || sweeps % 10 == 0) && polish(tol * scale)) {
+      polished = true;
+      return;
+    }
   }
   sweeps = max_sweeps;
   converged = false;
+}
+
+// The modes Gauss–Seidel has reached (mode_: 0 open or held by the
+// bilateral rows, 1 pushing with every row an equation — sticking, equality
+// or normal-only —, 2 sliding along dir_ = −u_f/|u_f|). false when no block
+// pushes (nothing to finish).
+bool ContactProblem::readModes() {
+  mode_.assign(blocks.size(), 0);
+  bool any = false;
+  for (int j = 0; j < static_cast<int>(blocks.size()); ++j) {
+    const ProblemBlock& b = blocks[j];
+    const int o = b.first;
+    if (!(W(o, o) > 0) || !(P[o] > 0)) continue;
+    any = true;
+    mode_[j] = 1;
+    const double pf = P.segment(o + 1, b.nf).norm();
+    const double slip = u.segment(o + 1, b.nf).norm();
+    if (b.nf > 0 && pf >= (1 - 1e-9) * b.mu * P[o] && slip > 0) {
+      mode_[j] = 2;
+      dir_[j].setZero();
+      dir_[j].head(b.nf) = -u.segment(o + 1, b.nf) / slip;
+    }
+  }
+  return any;
+}
+
+// The unknowns and equations of the modes: a pushing block's rows, or a
+// sliding block's normal row (its friction dragged along dir_).
+void ContactProblem::activeSet() {
+  unknown_row_.clear();
+  unknown_block_.clear();
+  for (int j = 0; j < static_cast<int>(blocks.size()); ++j) {
+    const ProblemBlock& b = blocks[j];
+    const int rows = mode_[j] == 1 ? b.rows() : mode_[j] == 2 ? 1 : 0;
+    for (int i = 0; i < rows; ++i) {
+      unknown_row_.push_back(b.first + i);
+      unknown_block_.push_back(j);
+    }
+  }
+}
+
+// P from the unknowns x: sliding blocks' friction μ P_n along dir_, open
+// blocks zero.
+void ContactProblem::expand(const VecX& x) {
+  P.head(n).setZero();
+  for (int k = 0; k < static_cast<int>(unknown_row_.size()); ++k) {
+    const int row = unknown_row_[k], j = unknown_block_[k];
+    P[row] = x[k];
+    if (mode_[j] == 2) {
+      const ProblemBlock& b = blocks[j];
+      P.segment(row + 1, b.nf) = b.mu * x[k] * dir_[j].head(b.nf);
+    }
+  }
+  u.head(n) = u_free.head(n);
+  u.head(n).noalias() += W.topLeftCorner(n, n) * P.head(n);
+}
+
+// One minimum-norm correction of x towards A x = target on the equation
+// rows: r = target − u, A Aᵀ y = r (Cholesky with a relative 1e-14 shift),
+// x += Aᵀ y. false when the factorization fails.
+bool ContactProblem::solveActiveSet() {
+  const int m = static_cast<int>(unknown_row_.size());
+  // A: the equation rows' response to each unknown (a sliding normal
+  // drags its friction along).
+  for (int k = 0; k < m; ++k) {
+    const int row = unknown_row_[k], j = unknown_block_[k];
+    for (int i = 0; i < m; ++i) {
+      const int e = unknown_row_[i];  // (each unknown's own row is its equation)
+      double a = W(e, row);
+      if (mode_[j] == 2) {
+        const ProblemBlock& b = blocks[j];
+        for (int f = 0; f < b.nf; ++f) a += b.mu * dir_[j][f] * W(e, row + 1 + f);
+      }
+      A_(i, k) = a;
+    }
+    r_[k] = target[row] - u[row];
+  }
+  auto Am = A_.topLeftCorner(m, m);
+  auto Bm = B_.topLeftCorner(m, m);
+  Bm.noalias() = Am * Am.transpose();
+  const double shift = 1e-14 * std::max(Bm.trace() / m, 1e-300);
+  // In-place Cholesky of B + shift·I (lower), then y by two triangular solves.
+  for (int c = 0; c < m; ++c) {
+    double d = Bm(c, c) + shift;
+    for (int k = 0; k < c; ++k) d -= Bm(c, k) * Bm(c, k);
+    if (!(d > 0)) return false;
+    const double l = std::sqrt(d);
+    Bm(c, c) = l;
+    for (int i = c + 1; i < m; ++i) {
+      double s = Bm(i, c);
+      for (int k = 0; k < c; ++k) s -= Bm(i, k) * Bm(c, k);
+      Bm(i, c) = s / l;
+    }
+  }
+  for (int i = 0; i < m; ++i) {
+    double s = r_[i];
+    for (int k = 0; k < i; ++k) s -= Bm(i, k) * y_[k];
+    y_[i] = s / Bm(i, i);
+  }
+  for (int i = m - 1; i >= 0; --i) {
+    double s = y_[i];
+    for (int k = i + 1; k < m; ++k) s -= Bm(k, i) * y_[k];
+    y_[i] = s / Bm(i, i);
+  }
+  x_.head(m).noalias() += Am.transpose() * y_.head(m);
+  return x_.head(m).allFinite();
+}
+
+// The active-set finish (contact_problem.hpp): from the modes Gauss–Seidel
+// reached, solve their equalities; a block that then pulls opens, a
+// sticking block outside its cone slides along its impulse, and the
+// equalities are solved again (at most once per block). Accepted when every
+// block's natural-map residual is within `tol` (which also checks the cone
+// and the sign of every normal impulse); else P and u are as Gauss–Seidel
+// left them.
+bool ContactProblem::polish(double tol) {
+  if (!readModes()) return false;
+  P_save_.head(n) = P.head(n);
+  u_save_.head(n) = u.head(n);
+  bool ok = false;
+  for (int round = 0; round <= static_cast<int>(blocks.size()) && !ok; ++round) {
+    activeSet();
+    if (unknown_row_.empty()) break;
+    if (!solveModes(tol)) break;
+    ok = maxResidual() <= tol;
+    if (ok || !adjustModes(tol)) break;
+  }
+  if (ok) {
+    residual = maxResidual();
+  } else {
+    P.head(n) = P_save_.head(n);
+    u.head(n) = u_save_.head(n);
+  }
+  return ok;
+}
+
+// x from Gauss–Seidel's impulses, then minimum-norm corrections (each
+// sliding direction renewed from the new slip) until the residual is within
+// tol or 12 solves are done (iterative refinement of the normal equations,
+// whose shift and round-off limit one solve to ~1e-10 on the car's rows);
+// P and u at the result. false when a solve fails.
+bool ContactProblem::solveModes(double tol) {
+  const int m = static_cast<int>(unknown_row_.size());
+  for (int k = 0; k < m; ++k) x_[k] = P_save_[unknown_row_[k]];
+  for (int it = 0; it < 12; ++it) {
+    expand(x_);
+    if (it > 0) {
+      for (int j = 0; j < static_cast<int>(blocks.size()); ++j) {
+        if (mode_[j] != 2) continue;
+        const ProblemBlock& b = blocks[j];
+        const double slip = u.segment(b.first + 1, b.nf).norm();
+        if (slip > 0) dir_[j].head(b.nf) = -u.segment(b.first + 1, b.nf) / slip;
+      }
+      expand(x_);
+      if (maxResidual() <= tol) return true;
+    }
+    if (!solveActiveSet()) return false;
+  }
+  expand(x_);
+  return true;
+}
+
+// After a solve whose result is off: the block that pulls most opens; else
+// the sticking block farthest outside its cone slides along its impulse.
+// false when neither applies (the finish gives up).
+bool ContactProblem::adjustModes(double tol) {
+  int pulling = -1, outside = -1;
+  double most_negative = 0, most_outside = 0;
+  for (int j = 0; j < static_cast<int>(blocks.size()); ++j) {
+    if (mode_[j] == 0) continue;
+    const ProblemBlock& b = blocks[j];
+    const double pn = P[b.first];
+    if (pn < most_negative) {
+      most_negative = pn;
+      pulling = j;
+    }
+    const double excess = P.segment(b.first + 1, b.nf).norm() - b.mu * pn;
+    if (mode_[j] == 1 && b.nf > 0 && b.ne == 0 && excess > most_outside) {
+      most_outside = excess;
+      outside = j;
+    }
+  }
+  if (pulling >= 0) {
+    mode_[pulling] = 0;
+    return true;
+  }
+  if (outside >= 0) {
+    const ProblemBlock& b = blocks[outside];
+    const double pf = P.segment(b.first + 1, b.nf).norm();
+    mode_[outside] = 2;
+    dir_[outside].setZero();
+    dir_[outside].head(b.nf) = P.segment(b.first + 1, b.nf) / pf;
+    return true;
+  }
+  // Equalities that no impulse meets (a contact whose gap target the others
+  // forbid, as a fourth tyre's on a rigid car): the least loaded one opens.
+  // (Not for a result near the tolerance: that is the solve's accuracy, and
+  // Gauss–Seidel's modes stand.)
+  if (maxResidual() < 1e4 * tol) return false;
+  int least = -1;
+  for (int j = 0; j < static_cast<int>(blocks.size()); ++j)
+    if (mode_[j] != 0 && (least < 0 || P[blocks[j].first] < P[blocks[least].first])) least = j;
+  if (least < 0) return false;
+  mode_[least] = 0;
+  return true;
 }
 
 }  // namespace appell::timestepping

@@ -89,6 +89,7 @@ class MoreauJean {
   int sweeps() const { return problem_.sweeps; }
   double residual() const { return problem_.residual; }
   bool converged() const { return problem_.converged; }
+  bool polished() const { return problem_.polished; }
   /// Candidate contacts of the last step.
   int candidates() const { return static_cast<int>(active_.size()); }
 

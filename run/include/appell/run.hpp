@@ -93,12 +93,14 @@ struct RunOptions {
   double near_dependency_level = 1e-3;
   /// Which scheme handles the contacts (docs/contacts.md §10).
   ContactScheme contacts = ContactScheme::Auto;
-  /// Stall watchdog: over every `watchdog_interval` seconds of wall time the
-  /// simulated time must advance at least `watchdog_fraction` of it. When it
-  /// does not, the automatic scheme opens a time-stepping window; otherwise
-  /// (events only, or already time-stepping) the run stops as failed, naming
-  /// the contacts, the events per simulated second and the last mode changes.
-  /// 0 switches it off.
+  /// Stall watchdog: over every `watchdog_interval` seconds of the run's CPU
+  /// time (its thread's) the simulated time must advance at least
+  /// `watchdog_fraction` of it. When it
+  /// does not, the run stops as failed, naming the contacts, the events per
+  /// simulated second and the last mode changes. It never switches the
+  /// scheme: a trajectory must not depend on the machine's load — the
+  /// automatic scheme's own stall rule (TimeSteppingOptions::
+  /// stall_evaluations) switches by counts. 0 switches it off.
   double watchdog_fraction = 1e-3;
   double watchdog_interval = 5.0;
 };
