@@ -113,6 +113,8 @@ struct Simulator::Impl {
   // Time-stepping windows (simulator/timestepping_window.cpp).
   bool decideContactModes(std::string& error);
   StepStatus timeSteppingStep(double h);
+  void recordTimeSteppingWork();
+  bool takeTimeSteppingModes();
   void openWindow(int constraint, std::string why);
   /// The time-stepping stage, built on first use (false: no unilateral
   /// constraint, or too large to allocate).

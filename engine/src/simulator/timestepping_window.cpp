@@ -225,6 +225,36 @@ void Simulator::Impl::watchEvents() {
   stall_evaluations0_ = counters_.evaluations;
 }
 
+// The step's counters and its work terms (timestepping::StepWork) into the
+// run's balance.
+void Simulator::Impl::recordTimeSteppingWork() {
+  ++counters_.timestepping_steps;
+  if (!mj_->converged()) ++counters_.unconverged;
+  counters_.contact_sweeps += mj_->sweeps();
+  counters_.contact_polished += mj_->polished();
+  counters_.max_contact_residual = std::max(counters_.max_contact_residual, mj_->residual());
+  const timestepping::StepWork& w = mj_->work();
+  dissipated_ += w.impact;
+  work_[kFrictionWork] += w.friction;
+  work_[kJointWork] += w.joint;
+  work_[kSupportWork] += w.support;
+}
+
+// The modes for reports (isClosed, sliding): what pushed and did not
+// rebound. True when some contact's mode changed since the last step.
+bool Simulator::Impl::takeTimeSteppingModes() {
+  bool changed = false;
+  for (const auto& r : uni_->rows) {
+    const timestepping::Mode m = mj_->modes()[r.c];
+    const bool closed = m != timestepping::Mode::Open && !mj_->rebounds(r.c);
+    cdata_->setActive(r.c, closed);
+    cdata_->setSliding(r.c, closed && m == timestepping::Mode::Slide);
+    changed = changed || last_modes_[r.c] != static_cast<signed char>(m);
+    last_modes_[r.c] = static_cast<signed char>(m);
+  }
+  return changed;
+}
+
 StepStatus Simulator::Impl::timeSteppingStep(double h) {
   StepStatus st;
   const double hs = std::min(h, options_.timestepping.step);
@@ -247,16 +277,7 @@ StepStatus Simulator::Impl::timeSteppingStep(double h) {
   st.h_taken = hs;
   st.h_next = options_.timestepping.step;
   st.evaluations = 1;
-  ++counters_.timestepping_steps;
-  if (!mj_->converged()) ++counters_.unconverged;
-  counters_.contact_sweeps += mj_->sweeps();
-  counters_.contact_polished += mj_->polished();
-  counters_.max_contact_residual = std::max(counters_.max_contact_residual, mj_->residual());
-  const timestepping::StepWork& w = mj_->work();
-  dissipated_ += w.impact;
-  work_[kFrictionWork] += w.friction;
-  work_[kJointWork] += w.joint;
-  work_[kSupportWork] += w.support;
+  recordTimeSteppingWork();
   // The drift projection holds the bilateral rows only: the contacts are
   // held by the step's own targets (a closing gap lands on g = 0), and a
   // projection of a floating body's position would turn its body-frame
@@ -280,16 +301,7 @@ StepStatus Simulator::Impl::timeSteppingStep(double h) {
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   velocity_residual_ = appell::velocityResidual(*data_, constraints_, *cdata_, v_);
   gap_residual_ = appell::gapResidual(*cdata_);
-  // The modes for reports (isClosed, sliding): what pushed and did not rebound.
-  bool changed = false;
-  for (const auto& r : uni_->rows) {
-    const timestepping::Mode m = mj_->modes()[r.c];
-    const bool closed = m != timestepping::Mode::Open && !mj_->rebounds(r.c);
-    cdata_->setActive(r.c, closed);
-    cdata_->setSliding(r.c, closed && m == timestepping::Mode::Slide);
-    changed = changed || last_modes_[r.c] != static_cast<signed char>(m);
-    last_modes_[r.c] = static_cast<signed char>(m);
-  }
+  const bool changed = takeTimeSteppingModes();
   // Reports: the step's forces (impulses over h), residuals, energy.
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   counters_.max_contact_gap = std::max(counters_.max_contact_gap, appell::gapResidual(*cdata_));
