@@ -30,7 +30,8 @@ struct Sweep {
   std::vector<double> values;  ///< count values from start to stop, evenly spaced
 };
 
-/// NAME=START:STOP:COUNT (COUNT ≥ 2, or 1 for START alone).
+/// NAME=START:STOP:COUNT (COUNT ≥ 2, or 1 for START alone): the sweep
+/// engine's grid axis (sweep_engine.hpp), for run and linearize --sweep.
 Sweep parseSweep(const std::string& spec);
 
 }  // namespace appell::cli
