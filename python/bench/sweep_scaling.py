@@ -79,6 +79,33 @@ def measure(work, executor, workers, repeat, reference):
     return statistics.median(walls), statistics.median(overheads), statistics.median(cpus), r
 
 
+def cli_sweep(appell_cli, work, workers, repeat):
+    """The same workload through `appell sweep` on 1 and on `workers` threads;
+    the tables checked byte for byte equal (--no-timing)."""
+    import subprocess
+
+    (name, values), = work["parameters"].items()
+    command = [appell_cli, "sweep", str(work["scene"]), "--no-timing",
+               "--vary", f"{name}={float(values[0])!r}:{float(values[-1])!r}:{len(values)}"]
+    if work.get("analysis") == "linearize":
+        command += ["--analysis", "linearize", "--cyclic", ",".join(work["cyclic"])]
+    if "duration" in work:
+        command += ["--duration", repr(work["duration"])]
+    tables, walls = {}, {}
+    for jobs in (1, workers):
+        times = []
+        for _ in range(repeat):
+            start = time.perf_counter()
+            out = subprocess.run(command + [f"-j{jobs}"], capture_output=True, check=True).stdout
+            times.append(time.perf_counter() - start)
+        tables[jobs], walls[jobs] = out, statistics.median(times)
+    if tables[1] != tables[workers]:
+        raise SystemExit("appell sweep: the tables of -j1 and -j%d differ" % workers)
+    print(f"{'appell -j1':>10} {walls[1]:9.3f}")
+    print(f"{f'appell -j{workers}':>10} {walls[workers]:9.3f} {walls[1] / walls[workers]:8.2f}×  (same bytes as -j1)",
+          flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=200)
@@ -86,6 +113,8 @@ def main():
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--executors", default="serial,threads,processes,dask")
     ap.add_argument("--workloads", default="disk-runs,disk-linearizations,bicycle")
+    ap.add_argument("--cli", help="also time `appell sweep` of the same workloads, -j1 against -jWORKERS, "
+                                  "with this appell binary (build/cli/appell)")
     args = ap.parse_args()
     print(f"load average before: {os.getloadavg()}")
     # Pools and the cluster start once, as a user running many sweeps keeps
@@ -119,6 +148,8 @@ def main():
                     serial, reference = wall, r
                 speedup = f"{serial / wall:8.2f}×" if serial else "        -"
                 print(f"{executor:>10} {wall:9.3f} {speedup} {1e3 * overhead:19.3f} {cpu:9.2f}", flush=True)
+            if args.cli:
+                cli_sweep(args.cli, work, args.workers, args.repeat)
             print(f"load average after {name}: {os.getloadavg()}")
     print(f"\nload average after: {os.getloadavg()}")
 
