@@ -58,7 +58,11 @@ std::vector<Row> readCsv(const std::string& text) {
 
 // `appell ARGS --out FILE`: the table written to a file (stderr apart).
 std::string sweepTable(const std::string& args, int expected_status = 0) {
-  const std::string out = ::testing::TempDir() + "sweep_table.txt";
+  // A file per test and call: ctest runs the tests as parallel processes.
+  static int calls = 0;
+  const std::string out = ::testing::TempDir() + "sweep_" +
+                          ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
+                          std::to_string(++calls) + ".txt";
   std::remove(out.c_str());
   const auto r = test::runAppell("sweep " + args + " --out " + out);
   EXPECT_EQ(r.status, expected_status) << r.output;
@@ -131,7 +135,7 @@ TEST(CliSweepCommand, GridOfTwoNamesEqualsSingleRunsBitForBit) {
     EXPECT_EQ(std::stod(rows[k].at("root_joint.wx")), lean_rate);
     expectRowEqualsSingle(rows[k], runAlone(kDisk, {{"speed", speed}, {"root_joint.wx", lean_rate}}, 0.4));
   }
-  const std::string traj = ::testing::TempDir() + "sweep_single.csv";
+  const std::string traj = ::testing::TempDir() + "sweep_command_single_run.csv";
   const auto single = test::runAppell("run " + kDisk + " --set speed=1.5 --set root_joint.wx=0.5 --duration 0.4 --quiet --out " + traj);
   ASSERT_EQ(single.status, 0) << single.output;
   const std::vector<Row> steps = readCsv(slurp(traj));
