@@ -5,6 +5,7 @@
 #include "linearize_analysis.hpp"
 #include "overrides.hpp"
 #include "plot.hpp"
+#include "sweep_command.hpp"
 #include "sweep_engine.hpp"
 
 #include <appell/appell.hpp>
@@ -113,19 +114,14 @@ int printOne(const Scene& scene, const Analysis& a, const std::vector<int>& cycl
   return 0;
 }
 
-int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
+int sweep(const SweepSetup& setup, const Args& args,
           const std::vector<int>& cyclic, Formulation form, const std::string& format) {
-  const Sweep sw = parseSweep(args.text("sweep"));
+  const SweepAxis& sw = setup.axes[0];
   std::vector<Analysis> out(sw.values.size());
   // One task per value on every core (the sweep engine), each its own scene copy and solver.
   const unsigned workers = defaultJobs(sw.values.size());
   const CaseOutcome done = forEachCase(sw.values.size(), workers, [&](std::size_t k) {
-    Scene s = base;
-    OverrideReport kept;
-    kept.kept = kept_base.kept;
-    applyOverride(s, sw.name, full(sw.values[k]), kept);
-    completeSetVelocities(s, kept);
-    out[k] = analyse(s, args, cyclic, form, false);
+    out[k] = analyse(caseScene(setup, {sw.values[k]}, false), args, cyclic, form, false);
   });
   for (std::size_t k = 0; k < done.errors.size(); ++k)
     if (!done.errors[k].empty()) throw UsageError(sw.name + "=" + full(sw.values[k]) + ": " + done.errors[k]);
@@ -135,12 +131,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
   // threshold (a real pair becoming imaginary), so interpolating it would be
   // off by a good part of the step.
   auto unstable = [&](double value) {
-    Scene s = base;
-    OverrideReport kept;
-    kept.kept = kept_base.kept;
-    applyOverride(s, sw.name, full(value), kept);
-    completeSetVelocities(s, kept);
-    const Analysis a = analyse(s, args, cyclic, form, false);
+    const Analysis a = analyse(caseScene(setup, {value}, false), args, cyclic, form, false);
     return std::pair<bool, bool>(a.ok, a.unstable());
   };
   std::vector<double> changes;
@@ -158,7 +149,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
     changes.push_back(0.5 * (lo + hi));
   }
   if (format == "json") {
-    std::cout << "{\"scene\": \"" << base.source << "\", \"parameter\": \"" << sw.name << "\", \"results\": [";
+    std::cout << "{\"scene\": \"" << setup.base.source << "\", \"parameter\": \"" << sw.name << "\", \"results\": [";
     for (std::size_t k = 0; k < out.size(); ++k) {
       const Analysis& a = out[k];
       std::cout << (k ? ",\n  " : "\n  ") << "{\"value\": " << full(sw.values[k]) << ", \"verdict\": \""
@@ -187,7 +178,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
       std::cout << "\n";
     }
   } else {
-    std::cout << "scene " << base.source << ": " << out.size() << " values of " << sw.name << " on "
+    std::cout << "scene " << setup.base.source << ": " << out.size() << " values of " << sw.name << " on "
               << workers << " threads\n"
               << std::setw(16) << sw.name << std::setw(18) << "largest Re" << "  verdict\n";
     for (std::size_t k = 0; k < out.size(); ++k) {
@@ -231,12 +222,15 @@ int linearize(int argc, char** argv) {
   // Overrides change the state: check it after them, not at load.
   const bool overrides = !args.all("set").empty();
   Scene scene = loadFromArgs(args, !args.has("equilibrium") && !overrides);
+  // --sweep: each value's case from the scene as loaded, the --set options
+  // then the value, as `appell sweep` and a single linearize build it.
+  const SweepSetup sweep_setup = args.has("sweep") ? oneAxisSetup(scene, args) : SweepSetup{};
   const OverrideReport kept = applyOverrides(scene, args);
   if (overrides && !args.has("equilibrium"))
     checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
   const std::vector<int> cyclic = cyclicCoordinates(scene, args);
   const Formulation form = linearizeFormulation(scene, args);
-  if (args.has("sweep")) return sweep(scene, kept, args, cyclic, form, format);
+  if (args.has("sweep")) return sweep(sweep_setup, args, cyclic, form, format);
   if (format == "text")
     for (const std::string& line : describe(scene, kept)) std::cout << "override     " << line << "\n";
   const Analysis a = analyse(scene, args, cyclic, form, format == "text");

@@ -334,21 +334,9 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
 // csv or json.
 int runSweep(const Args& args, const std::string& format) {
   if (args.has("out") || args.has("plot")) throw UsageError("--sweep writes a table, not a trajectory (--out, --plot)");
-  SweepSetup setup;
-  setup.axes = {parseSweepAxis("--sweep", args.text("sweep"))};
-  if (setup.axes[0].random())
-    throw UsageError("--sweep " + setup.axes[0].name + ": takes START:STOP:COUNT; random draws are appell sweep's "
-                     "--vary NAME=uniform(LOW,HIGH)");
-  setup.cases = sweepCases(setup.axes, 1, 0);
-  for (const std::string& set : args.all("set")) {
-    const auto eq = set.find('=');
-    if (eq == std::string::npos || eq == 0) throw UsageError("--set expects NAME=VALUE, got '" + set + "'");
-    setup.fixed.emplace_back(set.substr(0, eq), set.substr(eq + 1));
-  }
-  setup.base = loadFromArgs(args, false);  // each run's state is checked after its overrides
-  checkSweepNames(setup, "--sweep");
+  // Each run's state is checked after its overrides, not at load.
+  SweepSetup setup = oneAxisSetup(loadFromArgs(args, false), args);
   setup.run = runOptionsFromArgs(setup.base, args);
-  setup.project_initial = args.has("project-initial");
   return runSweepTable(setup, defaultJobs(setup.cases.size()), format, args, std::cout);
 }
 

@@ -125,11 +125,7 @@ SweepSetup setupFromArgs(const Args& args) {
   s.random = std::any_of(s.axes.begin(), s.axes.end(), [](const SweepAxis& a) { return a.random(); });
   if (args.has("seed") && !s.random) throw UsageError("--seed seeds random draws: no --vary is uniform(…) or normal(…)");
   s.cases = sweepCases(s.axes, static_cast<long>(samples), s.seed);
-  for (const std::string& set : args.all("set")) {
-    const auto eq = set.find('=');
-    if (eq == std::string::npos || eq == 0) throw UsageError("--set expects NAME=VALUE, got '" + set + "'");
-    s.fixed.emplace_back(set.substr(0, eq), set.substr(eq + 1));
-  }
+  s.fixed = fixedOverrides(args);
   s.base = loadFromArgs(args, false);  // each case's state is checked after its overrides
   checkSweepNames(s, "--vary");
   s.project_initial = args.has("project-initial");

@@ -1,8 +1,6 @@
 // --set and --sweep (overrides.hpp): text to numbers, usage errors.
 #include "overrides.hpp"
 
-#include "sweep_engine.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -60,14 +58,6 @@ OverrideReport applyOverrides(Scene& scene, const Args& args) {
   }
   completeSetVelocities(scene, report);
   return report;
-}
-
-Sweep parseSweep(const std::string& spec) {
-  const SweepAxis axis = parseSweepAxis("--sweep", spec);
-  if (axis.random())
-    throw UsageError("--sweep " + axis.name + ": takes START:STOP:COUNT; random draws are appell sweep's "
-                     "--vary NAME=uniform(LOW,HIGH)");
-  return Sweep{axis.name, axis.values};
 }
 
 }  // namespace appell::cli

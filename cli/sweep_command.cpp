@@ -18,6 +18,30 @@
 
 namespace appell::cli {
 
+std::vector<std::pair<std::string, std::string>> fixedOverrides(const Args& args) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const std::string& set : args.all("set")) {
+    const auto eq = set.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("--set expects NAME=VALUE, got '" + set + "'");
+    out.emplace_back(set.substr(0, eq), set.substr(eq + 1));
+  }
+  return out;
+}
+
+SweepSetup oneAxisSetup(Scene loaded, const Args& args) {
+  SweepSetup setup;
+  setup.axes = {parseSweepAxis("--sweep", args.text("sweep"))};
+  if (setup.axes[0].random())
+    throw UsageError("--sweep " + setup.axes[0].name + ": takes START:STOP:COUNT; random draws are appell sweep's "
+                     "--vary NAME=uniform(LOW,HIGH)");
+  setup.cases = sweepCases(setup.axes, 1, 0);
+  setup.fixed = fixedOverrides(args);
+  setup.base = std::move(loaded);
+  checkSweepNames(setup, "--sweep");
+  setup.project_initial = args.has("project-initial");
+  return setup;
+}
+
 Scene caseScene(const SweepSetup& s, const SweepCase& c, bool check) {
   Scene scene = s.base;
   OverrideReport report;

@@ -34,6 +34,13 @@ struct SweepSetup {
   bool timing = true;            ///< the wall_seconds column
 };
 
+/// The --set NAME=VALUE options of `args`, in order (UsageError without '=').
+std::vector<std::pair<std::string, std::string>> fixedOverrides(const Args& args);
+
+/// A one-axis setup for run --sweep and linearize --sweep: the scene as
+/// loaded, the --set options, the --sweep NAME=START:STOP:COUNT grid.
+SweepSetup oneAxisSetup(Scene loaded, const Args& args);
+
 /// The scene of case `c`: a copy of the base, the fixed overrides, then the
 /// case's values, the velocities completed once, and (`check`) the initial
 /// state checked — what `appell run --set … --set NAME=VALUE` computes.
