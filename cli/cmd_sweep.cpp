@@ -9,9 +9,7 @@
 // and message; the sweep goes on.
 #include "commands.hpp"
 #include "linearize_analysis.hpp"
-#include "overrides.hpp"
 #include "run_options.hpp"
-#include "sigint.hpp"
 #include "sweep_command.hpp"
 #include "sweep_engine.hpp"
 #include "sweep_table.hpp"
@@ -20,7 +18,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 
