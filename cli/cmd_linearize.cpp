@@ -2,8 +2,11 @@
 // equilibrium or a steady motion, in independent coordinates — once, or over
 // a sweep of a parameter (the stability diagram).
 #include "commands.hpp"
+#include "linearize_analysis.hpp"
 #include "overrides.hpp"
 #include "plot.hpp"
+#include "sweep_command.hpp"
+#include "sweep_engine.hpp"
 
 #include <appell/appell.hpp>
 #include <appell/equilibria.hpp>
@@ -64,102 +67,6 @@ Exit status 3 when the reference is not an equilibrium / steady motion.
   --package-path DIRS
 )" APPELL_INERTIA_HELP;
 
-struct Analysis {
-  bool ok = false;             ///< a verdict: the reference is an equilibrium / steady motion
-  std::string message;         ///< why not, when !ok
-  LinearizationResult result;
-  std::vector<std::complex<double>> eigenvalues;  ///< largest real part first
-  double tol = 0, max_real = 0;
-  int zeros = 0;
-  bool family = false;         ///< --family: the family's direction removed
-  double family_residual = 0;  ///< |L z₀| / |L|, z₀ the family's direction
-  /// The threshold of growth: the zero tolerance, or 0 once a family's own
-  /// null direction is removed (its boundaries are where a real part crosses 0).
-  double growthThreshold() const { return family ? 0.0 : tol; }
-  bool unstable() const { return max_real > growthThreshold(); }
-};
-
-// The eigenvalues of the quotient by a family of steady motions along the
-// reference velocity v: z₀ = Zᵀ (0, v/|v|) in the tangent basis Z, U an
-// orthonormal basis of z₀'s complement (Householder), the spectrum of Uᵀ L U.
-std::vector<std::complex<double>> familyQuotient(const LinearizationResult& r, const VecX& v, double& residual) {
-  // Below 1e-9 in every coordinate the velocity is the constraints' round-off
-  // (a bicycle set to rest keeps a front spin of 1e-15): no direction at all.
-  if (!(v.lpNorm<Eigen::Infinity>() > 1e-9))
-    throw UsageError("--family: the reference velocity is zero, so it spans no family");
-  VecX x0 = VecX::Zero(r.basis.rows());
-  x0.tail(v.size()) = v.normalized();
-  const VecX z0 = r.basis.transpose() * x0;
-  if (!(z0.norm() > 0.5))
-    throw UsageError("--family: the reference velocity leaves the tangent space of the constraints");
-  residual = (r.matrix * z0).norm() / std::max(r.matrix.norm(), 1e-300);
-  const MatX q = Eigen::HouseholderQR<MatX>(z0).householderQ();
-  const MatX u = q.rightCols(r.dimension - 1);
-  const Eigen::VectorXcd e = Eigen::EigenSolver<MatX>(u.transpose() * r.matrix * u, false).eigenvalues();
-  return {e.data(), e.data() + e.size()};
-}
-
-// One linearization of `scene` as the options say.
-Analysis analyse(const Scene& scene, const Args& args, const std::vector<int>& cyclic, Formulation form,
-                 bool print) {
-  Analysis a;
-  const Model& m = scene.model;
-  VecX q = scene.q0, v = scene.v0;
-  if (args.has("equilibrium")) {
-    EquilibriumOptions eo;
-    if (scene.tau.size() == m.nv) eo.tau = scene.tau;
-    const EquilibriumResult e = findEquilibrium(m, scene.constraints, scene.q0, eo);
-    if (!e.converged) {
-      a.message = e.message;
-      return a;
-    }
-    q = e.q;
-    v.setZero();
-    if (print)
-      std::cout << "equilibrium found (residual " << e.residual << ", local dimension "
-                << e.manifold_dimension << ")\n";
-  }
-  LinearizationOptions lo;
-  if (scene.tau.size() == m.nv) lo.tau = scene.tau;
-  lo.cyclic = cyclic;
-  lo.fd_step = args.positiveNumber("fd-step", lo.fd_step);
-  auto solver = makeSolver(form, m, scene.constraints);
-  a.result = linearize(m, scene.constraints, *solver, q, v, lo);
-  const LinearizationResult& r = a.result;
-  a.family = args.has("family");
-  if (a.family)
-    a.eigenvalues = familyQuotient(r, v, a.family_residual);
-  else
-    a.eigenvalues.assign(r.eigenvalues.data(), r.eigenvalues.data() + r.eigenvalues.size());
-  std::sort(a.eigenvalues.begin(), a.eigenvalues.end(), [](auto x, auto y) {
-    return x.real() != y.real() ? x.real() > y.real() : x.imag() > y.imag();
-  });
-  // Relative to the eigenvalues' scale: round-off in a fast system's
-  // eigenvalues is larger than 1e-4 in absolute terms, and is not instability.
-  double scale = 1.0;
-  for (const auto& z : a.eigenvalues) scale = std::max(scale, std::abs(z));
-  a.tol = args.positiveNumber("zero-tol", 1e-4) * scale;
-  a.zeros = static_cast<int>(std::count_if(a.eigenvalues.begin(), a.eigenvalues.end(),
-                                            [&](const auto& z) { return std::abs(z) <= a.tol; }));
-  a.max_real = a.eigenvalues.empty() ? 0.0 : a.eigenvalues.front().real();
-  if (r.steady_residual > 1e-6 * scale || r.constraint_residual > 1e-8) {
-    std::ostringstream s;
-    s << "the reference state is not an equilibrium or steady motion (steady residual "
-      << r.steady_residual << ")";
-    a.message = s.str();
-    return a;
-  }
-  if (a.family && a.family_residual > 1e-6) {
-    std::ostringstream s;
-    s << "the reference velocity is not the direction of a family of steady motions (|L z0| / |L| = "
-      << a.family_residual << "): drop --family";
-    a.message = s.str();
-    return a;
-  }
-  a.ok = true;
-  return a;
-}
-
 std::string full(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", x);
@@ -207,45 +114,24 @@ int printOne(const Scene& scene, const Analysis& a, const std::vector<int>& cycl
   return 0;
 }
 
-int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
+int sweep(const SweepSetup& setup, const Args& args,
           const std::vector<int>& cyclic, Formulation form, const std::string& format) {
-  const Sweep sw = parseSweep(args.text("sweep"));
+  const SweepAxis& sw = setup.axes[0];
   std::vector<Analysis> out(sw.values.size());
-  std::vector<std::string> errors(sw.values.size());
-  // One value per task, on every core; each task its own scene copy and solver.
-  const unsigned workers = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(),
-                                                           static_cast<unsigned>(sw.values.size())));
-  std::vector<std::thread> pool;
-  for (unsigned w = 0; w < workers; ++w)
-    pool.emplace_back([&, w] {
-      for (std::size_t k = w; k < sw.values.size(); k += workers) {
-        try {
-          Scene s = base;
-          OverrideReport kept;
-          kept.kept = kept_base.kept;
-          applyOverride(s, sw.name, full(sw.values[k]), kept);
-          completeSetVelocities(s, kept);
-          out[k] = analyse(s, args, cyclic, form, false);
-        } catch (const std::exception& e) {
-          errors[k] = e.what();
-        }
-      }
-    });
-  for (std::thread& t : pool) t.join();
-  for (std::size_t k = 0; k < errors.size(); ++k)
-    if (!errors[k].empty()) throw UsageError(sw.name + "=" + full(sw.values[k]) + ": " + errors[k]);
+  // One task per value on every core (the sweep engine), each its own scene copy and solver.
+  const unsigned workers = defaultJobs(sw.values.size());
+  const CaseOutcome done = forEachCase(sw.values.size(), workers, [&](std::size_t k) {
+    out[k] = analyse(caseScene(setup, {sw.values[k]}, false), args, cyclic, form, false);
+  });
+  for (std::size_t k = 0; k < done.errors.size(); ++k)
+    if (!done.errors[k].empty()) throw UsageError(sw.name + "=" + full(sw.values[k]) + ": " + done.errors[k]);
 
   // Where the verdict changes between neighbours, found by bisection to
   // 1e-9 relative: the largest real part vanishes like a square root at a
   // threshold (a real pair becoming imaginary), so interpolating it would be
   // off by a good part of the step.
   auto unstable = [&](double value) {
-    Scene s = base;
-    OverrideReport kept;
-    kept.kept = kept_base.kept;
-    applyOverride(s, sw.name, full(value), kept);
-    completeSetVelocities(s, kept);
-    const Analysis a = analyse(s, args, cyclic, form, false);
+    const Analysis a = analyse(caseScene(setup, {value}, false), args, cyclic, form, false);
     return std::pair<bool, bool>(a.ok, a.unstable());
   };
   std::vector<double> changes;
@@ -263,7 +149,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
     changes.push_back(0.5 * (lo + hi));
   }
   if (format == "json") {
-    std::cout << "{\"scene\": \"" << base.source << "\", \"parameter\": \"" << sw.name << "\", \"results\": [";
+    std::cout << "{\"scene\": \"" << setup.base.source << "\", \"parameter\": \"" << sw.name << "\", \"results\": [";
     for (std::size_t k = 0; k < out.size(); ++k) {
       const Analysis& a = out[k];
       std::cout << (k ? ",\n  " : "\n  ") << "{\"value\": " << full(sw.values[k]) << ", \"verdict\": \""
@@ -292,7 +178,7 @@ int sweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
       std::cout << "\n";
     }
   } else {
-    std::cout << "scene " << base.source << ": " << out.size() << " values of " << sw.name << " on "
+    std::cout << "scene " << setup.base.source << ": " << out.size() << " values of " << sw.name << " on "
               << workers << " threads\n"
               << std::setw(16) << sw.name << std::setw(18) << "largest Re" << "  verdict\n";
     for (std::size_t k = 0; k < out.size(); ++k) {
@@ -336,27 +222,15 @@ int linearize(int argc, char** argv) {
   // Overrides change the state: check it after them, not at load.
   const bool overrides = !args.all("set").empty();
   Scene scene = loadFromArgs(args, !args.has("equilibrium") && !overrides);
+  // --sweep: each value's case from the scene as loaded, the --set options
+  // then the value, as `appell sweep` and a single linearize build it.
+  const SweepSetup sweep_setup = args.has("sweep") ? oneAxisSetup(scene, args) : SweepSetup{};
   const OverrideReport kept = applyOverrides(scene, args);
   if (overrides && !args.has("equilibrium"))
     checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
-  std::vector<int> cyclic;
-  for (const std::string& c : args.list("cyclic")) {
-    int k;
-    try {
-      k = localCoordinateIndex(scene.model, c);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("--cyclic: ") + e.what());
-    }
-    if (k < 0) throw UsageError("--cyclic: no coordinate named '" + c + "' (names as the CSV's q: and v: columns)");
-    cyclic.push_back(k);
-  }
-  Formulation form;
-  try {
-    form = formulationFromString(args.text("formulation", scene.settings.formulation));
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  if (args.has("sweep")) return sweep(scene, kept, args, cyclic, form, format);
+  const std::vector<int> cyclic = cyclicCoordinates(scene, args);
+  const Formulation form = linearizeFormulation(scene, args);
+  if (args.has("sweep")) return sweep(sweep_setup, args, cyclic, form, format);
   if (format == "text")
     for (const std::string& line : describe(scene, kept)) std::cout << "override     " << line << "\n";
   const Analysis a = analyse(scene, args, cyclic, form, format == "text");

@@ -3,6 +3,10 @@
 #include "commands.hpp"
 #include "overrides.hpp"
 #include "plot.hpp"
+#include "run_options.hpp"
+#include "sigint.hpp"
+#include "sweep_command.hpp"
+#include "sweep_engine.hpp"
 
 #include <appell/output.hpp>
 #include <appell/run.hpp>
@@ -10,17 +14,14 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <limits>
-#include <thread>
 
 namespace appell::cli {
 
@@ -72,8 +73,9 @@ const char* kRunHelp = R"(usage: appell run SCENE.urdf [options]
                       exact sliding law throughout (default 1e-4)
   --sweep NAME=START:STOP:COUNT
                       one run per value of a one-number override, on every
-                      core (no trajectory): how each ended, its energy-balance
-                      error and residual, its final state
+                      core (no trajectory): the table of `appell sweep SCENE
+                      --vary NAME=START:STOP:COUNT` (see appell sweep --help:
+                      grids of several names, random draws, -j, its columns)
   --format F          with --sweep: text (default), csv or json at full precision
   --set NAME=VALUE    override the initial state or a parameter (repeatable):
                       gravity=gx,gy,gz, speed=V (a floating base's forward
@@ -324,130 +326,15 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
 
 }  // namespace
 
-// SIGINT while it lives sets a flag (RunOptions::stop) instead of killing the
-// process: a run stops after its current step, a sweep's runs stop and no
-// new one starts, and what was finished is still printed.
-namespace {
-
-constexpr int kInterrupted = 130;  // 128 + SIGINT, as a shell reports it
-std::atomic<bool> g_interrupted{false};
-class SigintGuard {
- public:
-  SigintGuard() : previous_(std::signal(SIGINT, [](int) { g_interrupted = true; })) { g_interrupted = false; }
-  ~SigintGuard() { std::signal(SIGINT, previous_); }
-  SigintGuard(const SigintGuard&) = delete;
-  SigintGuard& operator=(const SigintGuard&) = delete;
-  const std::atomic<bool>& flag() const { return g_interrupted; }
-
- private:
-  void (*previous_)(int);
-};
-
-}  // namespace
-
-// --sweep: one run per value on every core, a row per run — how it ended,
-// the largest energy-balance error and residual, and the final state — at
-// full precision in csv or json.
-// SIGINT stops the runs in progress after their current step and starts no
-// new one: the table lists every value, the runs not started as "not run",
-// and the exit status is 130.
-int runSweep(const Scene& base, const OverrideReport& kept_base, const Args& args,
-             const RunOptions& options, const std::string& format) {
-  const Sweep sw = parseSweep(args.text("sweep"));
-  struct Row {
-    RunSummary summary;
-    VecX q, v;
-    std::string error;
-    bool started = false;
-  };
-  const SigintGuard sigint_guard;
-  RunOptions stoppable = options;
-  stoppable.stop = &sigint_guard.flag();
-  std::vector<Row> rows(sw.values.size());
-  const unsigned workers = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(),
-                                                           static_cast<unsigned>(rows.size())));
-  auto number = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.17g", x);
-    return std::string(buf);
-  };
-  std::vector<std::thread> pool;
-  for (unsigned w = 0; w < workers; ++w)
-    pool.emplace_back([&, w] {
-      for (std::size_t k = w; k < rows.size() && !sigint_guard.flag().load(); k += workers) {
-        rows[k].started = true;
-        try {
-          Scene s = base;
-          OverrideReport kept;
-          kept.kept = kept_base.kept;
-          applyOverride(s, sw.name, number(sw.values[k]), kept);
-          completeSetVelocities(s, kept);
-          checkInitialState(s, args.has("project-initial"), LoadOptions().initial_state_tolerance);
-          rows[k].summary = runScene(s, stoppable, [&](const Simulator& sim) {
-            rows[k].q = sim.q();
-            rows[k].v = sim.v();
-          });
-        } catch (const std::exception& e) {
-          rows[k].error = e.what();
-        }
-      }
-    });
-  for (std::thread& t : pool) t.join();
-  const std::vector<std::string> qn = coordinateNames(base.model, false), vn = coordinateNames(base.model, true);
-  auto status = [](const Row& r) {
-    return !r.started               ? "not run"
-           : !r.error.empty()       ? "error"
-           : r.summary.interrupted  ? "interrupted"
-           : r.summary.ok           ? "ok"
-                                    : "failed";
-  };
-  if (format == "json") {
-    std::cout << "{\"scene\": \"" << base.source << "\", \"parameter\": \"" << sw.name << "\", \"runs\": [";
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      const Row& r = rows[k];
-      const RunSummary& m = r.summary;
-      std::cout << (k ? ",\n  " : "\n  ") << "{\"value\": " << number(sw.values[k]) << ", \"status\": \"" << status(r)
-                << "\", \"time\": " << number(m.time) << ", \"energy_error\": " << number(m.max_energy_deviation)
-                << ", \"max_residual\": " << number(std::max(m.max_velocity_residual, m.max_gap_residual))
-                << ", \"q\": {";
-      for (int i = 0; i < r.q.size(); ++i) std::cout << (i ? ", " : "") << "\"" << qn[i] << "\": " << number(r.q[i]);
-      std::cout << "}, \"v\": {";
-      for (int i = 0; i < r.v.size(); ++i) std::cout << (i ? ", " : "") << "\"" << vn[i] << "\": " << number(r.v[i]);
-      std::cout << "}}";
-    }
-    std::cout << "]}\n";
-  } else if (format == "csv") {
-    std::cout << sw.name << ",status,time,energy_error,max_residual";
-    for (const std::string& n : qn) std::cout << ",q:" << n;
-    for (const std::string& n : vn) std::cout << ",v:" << n;
-    std::cout << "\n";
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      const Row& r = rows[k];
-      std::cout << number(sw.values[k]) << "," << status(r) << "," << number(r.summary.time) << ","
-                << number(r.summary.max_energy_deviation) << ","
-                << number(std::max(r.summary.max_velocity_residual, r.summary.max_gap_residual));
-      for (int i = 0; i < base.model.nq; ++i) std::cout << "," << (i < r.q.size() ? number(r.q[i]) : "");
-      for (int i = 0; i < base.model.nv; ++i) std::cout << "," << (i < r.v.size() ? number(r.v[i]) : "");
-      std::cout << "\n";
-    }
-  } else {
-    std::cout << "scene " << base.source << ": " << rows.size() << " runs of " << sw.name << " on " << workers
-              << " threads\n";
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      const Row& r = rows[k];
-      std::cout << "  " << sw.name << " = " << std::setprecision(8) << sw.values[k] << ": " << status(r);
-      if (!r.error.empty()) std::cout << " (" << r.error << ")";
-      else if (!r.summary.ok) std::cout << " at t = " << r.summary.time << " (" << r.summary.failure << ")";
-      else std::cout << ", |E balance| ≤ " << r.summary.max_energy_deviation << " J, residual ≤ "
-                     << std::max(r.summary.max_velocity_residual, r.summary.max_gap_residual);
-      std::cout << "\n";
-    }
-  }
-  if (sigint_guard.flag().load()) {
-    std::cerr << "appell run: interrupted (SIGINT): the runs finished before it are listed\n";
-    return kInterrupted;
-  }
-  return std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.error.empty() && r.summary.ok; }) ? 0 : 3;
+// --sweep NAME=START:STOP:COUNT: appell sweep's table (sweep_command.hpp)
+// for one grid axis, its columns included, printed as text (a line per run),
+// csv or json.
+int runSweep(const Args& args, const std::string& format) {
+  if (args.has("out") || args.has("plot")) throw UsageError("--sweep writes a table, not a trajectory (--out, --plot)");
+  // Each run's state is checked after its overrides, not at load.
+  SweepSetup setup = oneAxisSetup(loadFromArgs(args, false), args);
+  setup.run = runOptionsFromArgs(setup.base, args);
+  return runSweepTable(setup, defaultJobs(setup.cases.size()), format, args, std::cout);
 }
 
 int run(int argc, char** argv) {
@@ -461,57 +348,22 @@ int run(int argc, char** argv) {
     std::cout << helpText(kRunHelp);
     return 0;
   }
-  // Overrides change the state: check it after them, not at load.
-  const bool overrides = !args.all("set").empty() || args.has("sweep");
-  Scene scene = loadFromArgs(args, !overrides);
-  OverrideReport kept;
-  if (overrides) {
-    kept = applyOverrides(scene, args);
-    if (!args.has("sweep"))
-      checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
-  }
   const std::string format = args.text("format", "text");
   if (format != "text" && format != "csv" && format != "json")
     throw UsageError("--format must be text, csv or json, not '" + format + "'");
   if (args.has("format") && !args.has("sweep"))
     throw UsageError("--format applies to a --sweep's table (a single run's numbers are in --out's CSV)");
-  SimulationSettings s = scene.settings;
-  s.duration = args.positiveNumber("duration", s.duration);
-  s.dt = args.positiveNumber("dt", s.dt);
-  s.tol = args.positiveNumber("tol", s.tol);
-  if (args.has("tol") && !args.has("integrator") &&
-      !adaptiveIntegrator(integratorFromString(s.integrator)))
-    s.integrator = toString(IntegratorType::DormandPrince54);
-  s.integrator = args.text("integrator", s.integrator);
-  s.formulation = args.text("formulation", s.formulation);
-  s.contacts = args.text("contacts", s.contacts);
+  if (args.has("sweep")) return runSweep(args, format);
+  // Overrides change the state: check it after them, not at load.
+  const bool overrides = !args.all("set").empty();
+  Scene scene = loadFromArgs(args, !overrides);
+  OverrideReport kept;
+  if (overrides) {
+    kept = applyOverrides(scene, args);
+    checkInitialState(scene, args.has("project-initial"), LoadOptions().initial_state_tolerance);
+  }
   if (args.has("plot") && !args.has("out")) throw UsageError("--plot plots the trajectory: give --out FILE.csv");
-  RunOptions options;
-  try {
-    options = runOptions(s);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  options.output_every = args.integer("every", 1);
-  if (args.has("max-energy-error"))
-    options.max_energy_error = args.text("max-energy-error") == "inf"
-                                   ? std::numeric_limits<double>::infinity()
-                                   : args.positiveNumber("max-energy-error", 5e-2);
-  if (args.has("max-residual"))
-    options.max_residual = args.text("max-residual") == "inf" ? std::numeric_limits<double>::infinity()
-                                                              : args.positiveNumber("max-residual", 1e-6);
-  if (args.has("settle-time")) {
-    options.settle_time = args.number("settle-time", options.settle_time);
-    if (!(options.settle_time >= 0) || !std::isfinite(options.settle_time))
-      throw UsageError("--settle-time must be a finite number ≥ 0 (seconds), not '" +
-                       args.text("settle-time") + "'");
-  }
-  if (options.output_every < 1) throw UsageError("option --every must be at least 1");
-  options.project_positions = options.project_velocities = !args.has("no-projection");
-  if (args.has("sweep")) {
-    if (args.has("out") || args.has("plot")) throw UsageError("--sweep writes a table, not a trajectory (--out, --plot)");
-    return runSweep(scene, kept, args, options, format);
-  }
+  RunOptions options = runOptionsFromArgs(scene, args);
 
   // SIGINT stops the run after the current step: the state reached is written
   // and flushed, the summary printed, and the exit status is 130.

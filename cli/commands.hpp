@@ -11,6 +11,7 @@ int run(int argc, char** argv);
 int info(int argc, char** argv);
 int equilibria(int argc, char** argv);
 int linearize(int argc, char** argv);
+int sweep(int argc, char** argv);
 int view(int argc, char** argv);
 int plot(int argc, char** argv);
 

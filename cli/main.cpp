@@ -17,6 +17,8 @@ commands:
   info         bodies, joints, degrees of freedom, contacts, constraint rows
   equilibria   find equilibria (including those held by nonholonomic reactions)
   linearize    eigenvalues of the linearized constrained dynamics
+  sweep        many cases (a grid or random draws of --set values) through
+               run or linearize on N threads: a CSV or JSON row per case
   view         a self-contained HTML page replaying a run in 3-D (three.js)
   plot         PNG plots of a run's CSV: energy, residuals, contact loads, path
 
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
     if (cmd == "info") status = info(argc, argv);
     if (cmd == "equilibria") status = equilibria(argc, argv);
     if (cmd == "linearize") status = linearize(argc, argv);
+    if (cmd == "sweep") status = sweep(argc, argv);
     if (cmd == "view") status = view(argc, argv);
     if (cmd == "plot") status = plot(argc, argv);
     if (status < 0) {

@@ -31,12 +31,6 @@ std::vector<double> numbersOf(const std::string& name, const std::string& text) 
   return out;
 }
 
-double oneNumber(const std::string& name, const std::string& text) {
-  const std::vector<double> x = numbersOf(name, text);
-  if (x.size() != 1) throw UsageError("--set " + name + ": takes one number, got " + std::to_string(x.size()));
-  return x[0];
-}
-
 }  // namespace
 
 void applyOverride(Scene& scene, const std::string& name, const std::string& value, OverrideReport& report) {
@@ -64,25 +58,6 @@ OverrideReport applyOverrides(Scene& scene, const Args& args) {
   }
   completeSetVelocities(scene, report);
   return report;
-}
-
-Sweep parseSweep(const std::string& spec) {
-  const auto eq = spec.find('=');
-  if (eq == std::string::npos || eq == 0)
-    throw UsageError("--sweep expects NAME=START:STOP:COUNT, got '" + spec + "'");
-  Sweep s;
-  s.name = spec.substr(0, eq);
-  std::vector<std::string> parts;
-  std::stringstream in(spec.substr(eq + 1));
-  for (std::string p; std::getline(in, p, ':');) parts.push_back(p);
-  if (parts.size() != 3) throw UsageError("--sweep " + s.name + ": expects START:STOP:COUNT");
-  const double a = oneNumber(s.name, parts[0]), b = oneNumber(s.name, parts[1]);
-  const double c = oneNumber(s.name, parts[2]);
-  if (!(c >= 1) || c != std::floor(c) || c > 100000)
-    throw UsageError("--sweep " + s.name + ": COUNT must be a whole number from 1 to 100000");
-  const int n = static_cast<int>(c);
-  for (int k = 0; k < n; ++k) s.values.push_back(n == 1 ? a : a + (b - a) * k / (n - 1));
-  return s;
 }
 
 }  // namespace appell::cli

@@ -1,5 +1,5 @@
-// State and parameter overrides on the command line (appell run and
-// linearize: --set NAME=VALUE, --sweep NAME=START:STOP:COUNT): the text
+// State and parameter overrides on the command line (appell run, linearize
+// and sweep: --set NAME=VALUE; the sweeps' values in sweep_engine.hpp): the text
 // parsed into numbers here, the names applied by the run library
 // (appell/overrides.hpp, which lists them), its errors made usage errors
 // ("--set NAME: reason"). A name that takes one number can be swept.
@@ -24,13 +24,5 @@ void completeSetVelocities(Scene& scene, OverrideReport& report);
 
 /// Every --set of `args`, in order, then the velocities completed.
 OverrideReport applyOverrides(Scene& scene, const Args& args);
-
-struct Sweep {
-  std::string name;
-  std::vector<double> values;  ///< count values from start to stop, evenly spaced
-};
-
-/// NAME=START:STOP:COUNT (COUNT ≥ 2, or 1 for START alone).
-Sweep parseSweep(const std::string& spec);
 
 }  // namespace appell::cli

@@ -1,22 +1,29 @@
 #!/usr/bin/env python3
 """appell.sweep on 2 cores: serial, 2 threads, 2 processes and a 2-worker Dask
-LocalCluster (127.0.0.1), on two workloads — 200 rolling-disk runs (speeds
-1…3 m/s, the scene's dopri5 at tol 1e-10, 2 s each) and 200 linearizations
+LocalCluster (127.0.0.1), on three workloads — 200 rolling-disk runs (speeds
+1…3 m/s, the scene's dopri5 at tol 1e-10, 2 s each), 200 linearizations
 of the steadily rolling disk (tests/data/linearize/disk_chain.urdf, spin
-1…6 rad/s). Median wall time of --repeat runs each, the speed-up against
+1…6 rad/s) and 200 linearizations of the Whipple bicycle
+(examples/bicycle, forward speed 3…7 m/s). Median wall time of --repeat runs each, the speed-up against
 serial, and the per-case overhead of each executor:
 
     overhead = (workers × wall − Σ the cases' own wall times) / cases,
 
 the time a worker spends per case on anything but the case (shipping,
-scheduling, gathering, idling at the end). The process pool and the
+scheduling, gathering, idling at the end), and CPU/wall, the cores this
+process used (serial and threads; 2 threads on 2 free cores give about 2 —
+less says the machine did not give them; processes and Dask work in other
+processes, so theirs is the parent's small share). The process pool and the
 cluster start once (their start-up printed apart) and run a two-case
 warm-up that loads the scene in each worker, as a user running many sweeps
 keeps them. Each sweep is checked equal to
 the serial one bit for bit. Not a test: the figures depend on the machine
-and its load (bench/RESULTS.md records runs with `uptime`).
+and its load, so the load average is printed before and after each
+workload (python/bench/results.md records runs with it).
 
     PYTHONPATH=build/python /usr/bin/python3 python/bench/sweep_scaling.py
+
+(--workloads disk-runs,bicycle picks some; --cases, --repeat, --workers.)
 """
 
 import argparse
@@ -35,13 +42,16 @@ import appell
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DISK = ROOT / "examples/rolling_disk/rolling_disk.urdf"
 CHAIN = ROOT / "tests/data/linearize/disk_chain.urdf"
+BIKE = ROOT / "examples/bicycle/bicycle.urdf"
 
 
 def workloads(cases):
     return {
-        "disk runs": dict(scene=DISK, parameters={"speed": np.linspace(1.0, 3.0, cases)}, duration=2.0),
-        "disk linearizations": dict(scene=CHAIN, parameters={"spin.velocity": np.linspace(1.0, 6.0, cases)},
+        "disk-runs": dict(scene=DISK, parameters={"speed": np.linspace(1.0, 3.0, cases)}, duration=2.0),
+        "disk-linearizations": dict(scene=CHAIN, parameters={"spin.velocity": np.linspace(1.0, 6.0, cases)},
                                     analysis="linearize", cyclic=["plane.x", "plane.y", "plane.theta", "spin"]),
+        "bicycle": dict(scene=BIKE, parameters={"plane.vx": np.linspace(3.0, 7.0, cases)}, analysis="linearize",
+                        cyclic=["plane.x", "plane.y", "plane.theta", "rear_spin", "front_spin"]),
     }
 
 
@@ -54,16 +64,46 @@ def measure(work, executor, workers, repeat, reference):
     walls, overheads = [], []
     appell.sweep(**dict(work, parameters={k: v[: 4 * workers] for k, v in work["parameters"].items()}),
                  executor=executor, workers=workers)  # warm-up: the workers load the scene
+    cpus = []
     for _ in range(repeat):
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), os.times()
         r = appell.sweep(executor=executor, workers=workers, **work)
         wall = time.perf_counter() - start
+        used = os.times()
+        cpus.append((used.user + used.system - cpu.user - cpu.system) / wall)
         n = 1 if executor == "serial" else workers
         walls.append(wall)
         overheads.append((n * wall - r["wall_seconds"].sum()) / len(r))
         if reference is not None and not same(r, reference):
             raise SystemExit(f"{executor}: results differ from the serial sweep")
-    return statistics.median(walls), statistics.median(overheads), r
+    return statistics.median(walls), statistics.median(overheads), statistics.median(cpus), r
+
+
+def cli_sweep(appell_cli, work, workers, repeat):
+    """The same workload through `appell sweep` on 1 and on `workers` threads;
+    the tables checked byte for byte equal (--no-timing)."""
+    import subprocess
+
+    (name, values), = work["parameters"].items()
+    command = [appell_cli, "sweep", str(work["scene"]), "--no-timing",
+               "--vary", f"{name}={float(values[0])!r}:{float(values[-1])!r}:{len(values)}"]
+    if work.get("analysis") == "linearize":
+        command += ["--analysis", "linearize", "--cyclic", ",".join(work["cyclic"])]
+    if "duration" in work:
+        command += ["--duration", repr(work["duration"])]
+    tables, walls = {}, {}
+    for jobs in (1, workers):
+        times = []
+        for _ in range(repeat):
+            start = time.perf_counter()
+            out = subprocess.run(command + [f"-j{jobs}"], capture_output=True, check=True).stdout
+            times.append(time.perf_counter() - start)
+        tables[jobs], walls[jobs] = out, statistics.median(times)
+    if tables[1] != tables[workers]:
+        raise SystemExit("appell sweep: the tables of -j1 and -j%d differ" % workers)
+    print(f"{'appell -j1':>10} {walls[1]:9.3f}")
+    print(f"{f'appell -j{workers}':>10} {walls[workers]:9.3f} {walls[1] / walls[workers]:8.2f}×  (same bytes as -j1)",
+          flush=True)
 
 
 def main():
@@ -72,6 +112,9 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--executors", default="serial,threads,processes,dask")
+    ap.add_argument("--workloads", default="disk-runs,disk-linearizations,bicycle")
+    ap.add_argument("--cli", help="also time `appell sweep` of the same workloads, -j1 against -jWORKERS, "
+                                  "with this appell binary (build/cli/appell)")
     args = ap.parse_args()
     print(f"load average before: {os.getloadavg()}")
     # Pools and the cluster start once, as a user running many sweeps keeps
@@ -92,16 +135,22 @@ def main():
                                                        host="127.0.0.1", dashboard_address=None))
             pools["dask"] = stack.enter_context(Client(cluster))
             print(f"dask LocalCluster of {args.workers} workers: {time.perf_counter() - start:.2f} s to start")
+        chosen = args.workloads.split(",")
         for name, work in workloads(args.cases).items():
-            print(f"\n{name}: {args.cases} cases, median of {args.repeat}")
-            print(f"{'executor':>10} {'wall (s)':>9} {'speed-up':>9} {'overhead/case (ms)':>19}")
+            if name not in chosen:
+                continue
+            print(f"\n{name}: {args.cases} cases, median of {args.repeat}; load average {os.getloadavg()}")
+            print(f"{'executor':>10} {'wall (s)':>9} {'speed-up':>9} {'overhead/case (ms)':>19} {'CPU/wall':>9}")
             serial, reference = None, None
             for executor in names:
-                wall, overhead, r = measure(work, pools[executor], args.workers, args.repeat, reference)
+                wall, overhead, cpu, r = measure(work, pools[executor], args.workers, args.repeat, reference)
                 if executor == "serial":
                     serial, reference = wall, r
                 speedup = f"{serial / wall:8.2f}×" if serial else "        -"
-                print(f"{executor:>10} {wall:9.3f} {speedup} {1e3 * overhead:19.3f}", flush=True)
+                print(f"{executor:>10} {wall:9.3f} {speedup} {1e3 * overhead:19.3f} {cpu:9.2f}", flush=True)
+            if args.cli:
+                cli_sweep(args.cli, work, args.workers, args.repeat)
+            print(f"load average after {name}: {os.getloadavg()}")
     print(f"\nload average after: {os.getloadavg()}")
 
 

@@ -49,32 +49,42 @@ MatX rows(const std::vector<VecX>& x, int n) {
 
 /// The scene with `overrides` (name → number or sequence, in order) applied
 /// and its velocities completed; `describe`'s lines.
+// The Python overrides as (name, values), read with the GIL held.
+std::vector<std::pair<std::string, std::vector<double>>> overrideList(py::handle overrides) {
+  std::vector<std::pair<std::string, std::vector<double>>> out;
+  if (overrides.is_none()) return out;
+  py::object items = py::isinstance<py::dict>(overrides) ? overrides.attr("items")() : py::reinterpret_borrow<py::object>(overrides);
+  for (py::handle item : items) {
+    auto pair = item.cast<py::tuple>();
+    if (pair.size() != 2) throw py::value_error("an override is a (name, value) pair");
+    const std::string name = pair[0].cast<std::string>();
+    if (py::isinstance<py::str>(pair[1]))
+      throw py::value_error(name + ": give a number or a sequence of numbers, not a string");
+    out.emplace_back(name, py::hasattr(pair[1], "__len__") ? pair[1].cast<std::vector<double>>()
+                                                           : std::vector<double>{pair[1].cast<double>()});
+  }
+  return out;
+}
+
+// A copy of the scene with the overrides applied and the velocities
+// completed. Everything but reading the Python objects runs with the GIL
+// released — the scene's copy (its model, constraints and meshes) included —
+// so that the cases of a threaded sweep do not take turns here.
 std::pair<std::shared_ptr<Scene>, std::vector<std::string>> withOverrides(const Scene& base, py::handle overrides,
                                                                          OverrideReport* report_out = nullptr) {
-  auto scene = std::make_shared<Scene>(base);
+  const auto list = overrideList(overrides);
+  std::shared_ptr<Scene> scene;
   OverrideReport report;
-  if (!overrides.is_none()) {
-    py::object items = py::isinstance<py::dict>(overrides) ? overrides.attr("items")() : py::reinterpret_borrow<py::object>(overrides);
-    for (py::handle item : items) {
-      auto pair = item.cast<py::tuple>();
-      if (pair.size() != 2) throw py::value_error("an override is a (name, value) pair");
-      const std::string name = pair[0].cast<std::string>();
-      std::vector<double> values;
-      if (py::isinstance<py::str>(pair[1]))
-        throw py::value_error(name + ": give a number or a sequence of numbers, not a string");
-      if (py::hasattr(pair[1], "__len__"))
-        values = pair[1].cast<std::vector<double>>();
-      else
-        values.push_back(pair[1].cast<double>());
-      applyOverride(*scene, name, values, report);
-    }
-  }
+  std::vector<std::string> lines;
   {
     py::gil_scoped_release release;
+    scene = std::make_shared<Scene>(base);
+    for (const auto& [name, values] : list) applyOverride(*scene, name, values, report);
     completeVelocities(*scene, report);
+    lines = describe(*scene, report);
   }
   if (report_out) *report_out = report;
-  return {scene, describe(*scene, report)};
+  return {scene, lines};
 }
 
 RunOptions options(const Scene& s, std::optional<double> duration, std::optional<double> dt,

@@ -144,11 +144,13 @@ def test_the_table_writes_to_csv_at_full_precision(tmp_path):
 
 
 @pytest.mark.skipif(not os.environ.get("APPELL_CLI"), reason="APPELL_CLI (set by ctest) names the CLI")
-def test_a_cli_run_sweep_row_is_the_same_run_as_the_python_sweeps():
-    # `appell run --sweep` applies the same override rules (run/src/overrides.cpp)
-    # to the same runner: its CSV (%.17g) reads back the Python sweep's doubles.
-    out = subprocess.run([os.environ["APPELL_CLI"], "run", str(DISK), "--sweep", "speed=1:2:3", "--format", "csv",
-                          "--duration", "0.3", "--integrator", "rk4", "--dt", "2e-3"],
+@pytest.mark.parametrize("command", [["sweep", "--vary"], ["run", "--sweep"]])
+def test_a_cli_sweep_row_is_the_same_run_as_the_python_sweeps(command):
+    # `appell sweep` (and `appell run --sweep`, its one-name form) applies the
+    # same override rules (run/src/overrides.cpp) to the same runner: its CSV
+    # (the shortest text of each double) reads back the Python sweep's numbers.
+    out = subprocess.run([os.environ["APPELL_CLI"], command[0], str(DISK), command[1], "speed=1:2:3",
+                          "--format", "csv", "--duration", "0.3", "--integrator", "rk4", "--dt", "2e-3"],
                          capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
@@ -161,4 +163,6 @@ def test_a_cli_run_sweep_row_is_the_same_run_as_the_python_sweeps():
         q = [float(row[header.index("q:" + n)]) for n in scene.position_names]
         v = [float(row[header.index("v:" + n)]) for n in scene.velocity_names]
         assert np.array_equal(q, result["q"][k]) and np.array_equal(v, result["v"][k]), k
-        assert float(row[header.index("energy_error")]) == result["max_energy_deviation"][k]
+        for name in RUN_COLUMNS + ["relative_energy_deviation"]:
+            assert float(row[header.index(name)]) == result[name][k], name
+        assert int(row[header.index("steps")]) == result["steps"][k]
