@@ -103,7 +103,58 @@ void expectLinearMemory(bool limits) {
   EXPECT_LT(large.bytes / 100000.0, 64.0 * 1024) << "bytes per body";
 }
 
+/// n balls (radius 0.1 m, 1 kg) at rest on a floor, each on a floating
+/// joint from the world, each touching with μ = 0.5: n islands of one
+/// frictional contact (engine/src/simulator/islands.cpp).
+std::string ballsUrdf(int n) {
+  std::ostringstream u;
+  u << "<robot name=\"balls\">\n<link name=\"world\"/>\n";
+  for (int i = 0; i < n; ++i)
+    u << "<link name=\"b" << i << "\"><inertial><mass value=\"1\"/><inertia ixx=\"0.004\" "
+      << "iyy=\"0.004\" izz=\"0.004\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n"
+      << "<joint name=\"j" << i << "\" type=\"floating\"><parent link=\"world\"/><child link=\"b" << i
+      << "\"/><origin xyz=\"" << 0.3 * (i % 60) << " " << 0.3 * (i / 60) << " 0.1\"/></joint>\n";
+  u << "<appell><gravity xyz=\"0 0 -9.81\"/>"
+    << "<support name=\"floor\" type=\"plane\" normal=\"0 0 1\" offset=\"0\"/>\n";
+  for (int i = 0; i < n; ++i)
+    u << "<contact name=\"c" << i << "\" link=\"b" << i
+      << "\" kind=\"rolling\" shape=\"sphere\" radius=\"0.1\" support=\"floor\" mu=\"0.5\"/>\n";
+  u << "</appell></robot>\n";
+  return u.str();
+}
+
+/// Bytes held by n balls' scene and simulator after one step; the balls
+/// stay at rest (each sticking, its normal load m g).
+std::size_t ballsBytes(int n) {
+  const std::size_t before = bytesInUse();
+  std::size_t bytes = 0;
+  {
+    const Scene scene = loadSceneFromString(ballsUrdf(n), ".");
+    const auto sim = makeSimulator(scene, runOptions(scene.settings));
+    const StepStatus st = sim->step(1e-3);
+    EXPECT_TRUE(st.ok) << st.message;
+    bytes = bytesInUse() - before;
+    EXPECT_LT(sim->v().lpNorm<Eigen::Infinity>(), 1e-12) << "at rest";
+    EXPECT_NEAR(sim->lambda()[2], 9.81, 1e-9) << "the first ball's normal load";
+  }
+  return bytes;
+}
+
 }  // namespace
+
+// Protects: friction-contact bookkeeping O(contacts) (docs/hardening.md,
+// "Memory"). The friction problems' storage is sized for the largest island,
+// not for every contact: 3 000 balls with friction once took 5.1 GB (a
+// 6 000 × 6 000 friction operator and its kin), and 1 000 → 3 000 balls
+// grew it 9×.
+TEST(LargeModels, ThreeThousandBallsWithFrictionTakeLinearMemory) {
+  if (kSanitized) GTEST_SKIP() << "mallinfo2 does not see a sanitizer's allocator";
+  const std::size_t small = ballsBytes(1000), large = ballsBytes(3000);
+  ASSERT_GT(small, 0u);
+  ::testing::Test::RecordProperty("bytes_3000_balls", static_cast<int>(large));
+  EXPECT_LT(static_cast<double>(large) / static_cast<double>(small), 3.6) << small << " → " << large;
+  EXPECT_LT(large, 200u << 20) << "bytes for 3 000 balls";
+}
 
 TEST(LargeModels, ChainOf100000LinksLoadsAndStepsInLinearMemory) {
   if (kSanitized) GTEST_SKIP() << "mallinfo2 does not see a sanitizer's allocator";

@@ -50,35 +50,33 @@ void detail::slipDirection(const ConstraintData& cd, UnilateralRow& r, double fl
   else r.dir = r.dir_start;
 }
 
-// Marks the sliding contacts (u.sliding); true when one of them may slide
-// on its settled direction (friction_settled.cpp): its slip is small beside
-// the state's speeds.
+// Marks the sliding contacts (u.sliding, island by island); true when one
+// of them may slide on its settled direction (friction_settled.cpp): its
+// slip is small beside the state's speeds.
 bool Simulator::Impl::markSliding(const VecX& v) {
   auto& u = *uni_;
   const double screen = options_.contacts.settle_time > 0 && !u.settle_off
                             ? detail::kSettleScreen * v.lpNorm<Eigen::Infinity>()
                             : -1.0;
   bool settling = false;
-  u.sliding.clear();  // capacity reserved: no allocation
-  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
+  detail::gatherByIsland(u.islands, u.sliding, u.sliding_runs, [&](int k) {
     UnilateralRow& r = u.rows[k];
-    if (r.released) continue;
+    if (r.released) return false;
     r.settling = false;
-    if (!cdata_->isActive(r.c) || !cdata_->isSliding(r.c)) continue;
-    u.sliding.push_back(k);
+    if (!cdata_->isActive(r.c) || !cdata_->isSliding(r.c)) return false;
     if (r.nf > 0 && r.creep == 0 && cdata_->slide[r.c].slip.norm() <= screen) r.settling = settling = true;
-  }
+    return true;
+  });
   return settling;
 }
 
-// Friction forces per unit normal load gⱼ (columns of u.G), from the rows'
-// covectors (world spatial forces on A and B), with data_ at
-// forwardKinematics(q, v).
-void Simulator::Impl::slidingFrictionColumns() {
+// Friction forces per unit normal load gⱼ (columns of u.G) of one island's
+// sliding contacts, from the rows' covectors (world spatial forces on A and
+// B) and their slip directions, with data_ at forwardKinematics(q, v).
+void Simulator::Impl::slidingFrictionColumns(std::span<const int> run) {
   auto& u = *uni_;
-  for (int j = 0; j < static_cast<int>(u.sliding.size()); ++j) {
-    UnilateralRow& r = u.rows[u.sliding[j]];
-    detail::slipDirection(*cdata_, r, 10 * options_.contacts.speed_tol);
+  for (int j = 0; j < static_cast<int>(run.size()); ++j) {
+    const UnilateralRow& r = u.rows[run[j]];
     const auto& sr = cdata_->slide[r.c];
     const Vec3 f = -r.mu_k * r.dir;  // components along the friction rows (kinetic μ)
     auto g = u.G.col(j);
@@ -94,27 +92,62 @@ void Simulator::Impl::slidingFrictionColumns() {
   }
 }
 
-// 1 − R, R the normal loads' responses to each contact's unit friction
-// force: one solve at τ (λₙ⁰ into u.lam0, the full result in out) and one
-// at τ + gⱼ per sliding contact.
+// 1 − R of one island (its sliding contacts from u.sliding[first] on), R the
+// normal loads' responses to each contact's unit friction force: one solve at
+// τ + gⱼ per sliding contact, against λₙ⁰ (u.lam0, the solve at τ).
 bool Simulator::Impl::slidingLoadResponses(const VecX& q, const VecX& v, const VecX& tau,
+                                           int first, std::span<const int> run,
                                            ConstrainedResult& out) {
   auto& u = *uni_;
-  const int k = static_cast<int>(u.sliding.size());
-  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, SolveOutputs::All);
-  if (!out.ok) return false;
-  for (int i = 0; i < k; ++i) u.lam0[i] = out.lambda[u.rows[u.sliding[i]].global];
+  const int k = static_cast<int>(run.size());
   for (int j = 0; j < k; ++j) {
-    u.tau_f = tau + u.G.col(j);
-    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u.tau_f, u.unit, SolveOutputs::All);
+    u.tau_unit = tau + u.G.col(j);
+    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u.tau_unit, u.unit, SolveOutputs::All);
     if (!u.unit.ok) {
       out.ok = false;
       out.error = u.unit.error;
       return false;
     }
     for (int i = 0; i < k; ++i)
-      u.R(i, j) = (i == j ? 1.0 : 0.0) - (u.unit.lambda[u.rows[u.sliding[i]].global] - u.lam0[i]);
+      u.R(i, j) = (i == j ? 1.0 : 0.0) - (u.unit.lambda[u.rows[run[i]].global] - u.lam0[first + i]);
   }
+  return true;
+}
+
+// The normal loads of one island's sliding contacts, (1 − R) λₙ = λₙ⁰ on the
+// leading block of R's storage (sized for the largest island), into u.s;
+// their friction added to u.tau_f and its power to u.friction_power.
+// 1 − R is how the normal loads answer themselves through the friction
+// they cause. A consistent, unique sliding mode for every λₙ⁰ needs it to
+// be a P-matrix (Cottle, Pang & Stone, The Linear Complementarity Problem,
+// 1992, §3.3): for one contact 1 − R > 0 — Painlevé's rod at μ > 4/3 is
+// the classic failure (Stewart, SIAM Review 42 (2000) 3–39) — and a
+// positive determinant in general (necessary). Otherwise the loads have no
+// solution with λₙ ≥ 0 or several: reported, never picked.
+bool Simulator::Impl::slidingNormalLoads(const VecX& q, const VecX& v, const VecX& tau, int first,
+                                         std::span<const int> run, ConstrainedResult& out) {
+  auto& u = *uni_;
+  const int k = static_cast<int>(run.size());
+  slidingFrictionColumns(run);
+  if (!slidingLoadResponses(q, v, tau, first, run, out)) return false;
+  auto fail = [&](const char* why) {
+    out.ok = false;
+    out.error = std::string("sliding friction: ") + why + " at contacts";
+    for (int j : run) out.error += " '" + constraints_[u.rows[j].c]->name() + "'";
+    out.error += " (a Painlevé-type configuration: no consistent sliding mode)";
+    return false;
+  };
+  u.lu.compute(u.R.topLeftCorner(k, k));
+  const double det = u.lu.determinant();
+  if (!(std::abs(det) > 1e-12)) return fail("the normal loads are not determined");
+  if (det < 0)
+    return fail("the friction of the sliding contacts turns their normal loads against "
+                "themselves (det(1 − R) < 0)");
+  u.s.segment(first, k) = u.lu.solve(u.lam0.segment(first, k));
+  if (!u.s.segment(first, k).allFinite()) return fail("the normal loads are not finite");
+  for (int j = 0; j < k; ++j) u.tau_f.noalias() += u.s[first + j] * u.G.col(j);
+  // The power these forces take, −vᵀ(τ_f − τ): the work balance's rate.
+  for (int j = 0; j < k; ++j) u.friction_power -= u.s[first + j] * u.G.col(j).dot(v);
   return true;
 }
 
@@ -128,35 +161,18 @@ bool Simulator::Impl::solveDynamics(double t, const VecX& q, const VecX& v, cons
     return out.ok;
   }
   const int k = static_cast<int>(u->sliding.size());
-  slidingFrictionColumns();
-  if (!slidingLoadResponses(q, v, tau, out)) return false;
-  auto fail = [&](const char* why) {
-    out.ok = false;
-    out.error = std::string("sliding friction: ") + why + " at contacts";
-    for (int j = 0; j < k; ++j) out.error += " '" + constraints_[u->rows[u->sliding[j]].c]->name() + "'";
-    out.error += " (a Painlevé-type configuration: no consistent sliding mode)";
-    return false;
-  };
-  // (1 − R) λₙ = λₙ⁰ on the leading k × k block (storage sized once).
-  // 1 − R is how the normal loads answer themselves through the friction
-  // they cause. A consistent, unique sliding mode for every λₙ⁰ needs it to
-  // be a P-matrix (Cottle, Pang & Stone, The Linear Complementarity Problem,
-  // 1992, §3.3): for one contact 1 − R > 0 — Painlevé's rod at μ > 4/3 is
-  // the classic failure (Stewart, SIAM Review 42 (2000) 3–39) — and a
-  // positive determinant in general (necessary). Otherwise the loads have no
-  // solution with λₙ ≥ 0 or several: reported, never picked.
-  u->lu.compute(u->R.topLeftCorner(k, k));
-  const double det = u->lu.determinant();
-  if (!(std::abs(det) > 1e-12)) return fail("the normal loads are not determined");
-  if (det < 0)
-    return fail("the friction of the sliding contacts turns their normal loads against "
-                "themselves (det(1 − R) < 0)");
-  u->s.head(k) = u->lu.solve(u->lam0.head(k));
-  if (!u->s.head(k).allFinite()) return fail("the normal loads are not finite");
+  for (int j : u->sliding)
+    detail::slipDirection(*cdata_, u->rows[j], 10 * options_.contacts.speed_tol);
+  // λₙ⁰: the solve at τ (the full result in out).
+  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, SolveOutputs::All);
+  if (!out.ok) return false;
+  for (int i = 0; i < k; ++i) u->lam0[i] = out.lambda[u->rows[u->sliding[i]].global];
+  // Island by island: their loads do not answer one another's friction.
   u->tau_f = tau;
-  for (int j = 0; j < k; ++j) u->tau_f.noalias() += u->s[j] * u->G.col(j);
-  // The power these forces take, −vᵀ(τ_f − τ): the work balance's rate.
-  for (int j = 0; j < k; ++j) u->friction_power -= u->s[j] * u->G.col(j).dot(v);
+  for (int i = 0; i + 1 < static_cast<int>(u->sliding_runs.size()); ++i)
+    if (!slidingNormalLoads(q, v, tau, u->sliding_runs[i],
+                            detail::runOf(u->sliding, u->sliding_runs, i), out))
+      return false;
   solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u->tau_f, out, outputs);
   if (!out.ok) return false;
   if (outputs != SolveOutputs::All) return true;

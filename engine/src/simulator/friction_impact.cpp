@@ -57,9 +57,7 @@ bool Simulator::Impl::frictionImpact(std::string& error, int& separating) {
   auto& u = *uni_;
   // Here v_ = v⁺ with every contact sticking, u.vplus = v⁻, u.impulse the
   // projection's multipliers (the push along a row is −impulse).
-  int F = 0;
-  if (!frictionImpactCandidates(F)) return true;
-  const int K = static_cast<int>(u.onset.size());
+  if (!frictionImpactCandidates()) return true;
   u.vstick = v_;
   u.vminus = u.vplus;
   for (int k : u.onset) {
@@ -67,16 +65,45 @@ bool Simulator::Impl::frictionImpact(std::string& error, int& separating) {
     cdata_->setSliding(u.rows[k].c, true);
     u.rows[k].released = true;
   }
-  auto& p = u.onset_problem;
-  if (!frictionImpactMaps(F, error)) {
-    releaseOnset(false);
-    v_ = u.vstick;
-    return false;
+  // Island by island (islands.cpp): each island's impulses, kept per row,
+  // and v⁺ = v⁰ + Σ V P summed in u.vsum; applied once all are found.
+  for (int i = 0; i + 1 < static_cast<int>(u.onset_runs.size()); ++i) {
+    const int found = frictionImpactIsland(detail::runOf(u.onset, u.onset_runs, i), i == 0, error);
+    if (found < 0) {
+      releaseOnset(false);
+      v_ = u.vstick;
+      return false;
+    }
+    if (found == 0) {
+      // Keep the sticking impact (its cone excess is then reported).
+      ++counters_.friction_onset_unsettled;
+      releaseOnset(false);
+      v_ = u.vstick;
+      forwardKinematics(model_, *data_, q_, v_);
+      return true;
+    }
   }
+  v_ = u.vsum;
+  if (!applyFrictionImpulses(separating, error)) return false;
+  releaseOnset(true);
+  forwardKinematics(model_, *data_, q_, v_);
+  return true;
+}
+
+/// One island's friction impulses: 1 when found (kept in its rows' impact
+/// state, V P added to u.vsum — which the first island starts at v⁰), 0
+/// when the sweeps did not settle, −1 with `error` when a solve failed.
+int Simulator::Impl::frictionImpactIsland(std::span<const int> run, bool first,
+                                          std::string& error) {
+  auto& u = *uni_;
+  auto& p = u.onset_problem;
+  const int K = static_cast<int>(run.size());
+  const int F = detail::numberUnknowns(u.rows, run, &UnilateralRow::first_force);
+  if (!frictionImpactMaps(run, F, error)) return -1;
   // Block Gauss–Seidel over the disks, the normal impulses updated: a
   // contact sticks inside its static disk, else slides on its kinetic one.
   const bool settled = p.gaussSeidel(K, F, 10000, [&](int j) {
-    const UnilateralRow& r = u.rows[u.onset[j]];
+    const UnilateralRow& r = u.rows[run[j]];
     const int o0 = r.first_force, n = r.nf;
     const double pn = std::max(0.0, p.loadAt(j, F));
     Mat3 H;
@@ -87,51 +114,40 @@ bool Simulator::Impl::frictionImpact(std::string& error, int& separating) {
     p.f.segment(o0, n) = fj.head(n);
     return r.mu * pn;
   });
-  if (!settled) {
-    // Keep the sticking impact (its cone excess is then reported).
-    ++counters_.friction_onset_unsettled;
-    releaseOnset(false);
-    v_ = u.vstick;
-    forwardKinematics(model_, *data_, q_, v_);
-    return true;
-  }
-  // v⁺ = v⁰ + V P; the impulses for the log; the modes after the impact.
-  v_ = u.vplus;
-  v_.noalias() += p.V.leftCols(F) * p.f.head(F);
+  if (!settled) return 0;
+  // v⁺ = v⁰ + V P; the impulses and the slips after, for the log and the modes.
+  if (first) u.vsum = u.vplus;
+  u.vsum.noalias() += p.V.leftCols(F) * p.f.head(F);
   p.acc.head(F) = p.a0.head(F);
   p.acc.head(F).noalias() += p.W.topLeftCorner(F, F) * p.f.head(F);
-  if (!applyFrictionImpulses(F, separating, error)) return false;
-  releaseOnset(true);
-  forwardKinematics(model_, *data_, q_, v_);
-  return true;
+  for (int j = 0; j < K; ++j) {
+    UnilateralRow& r = u.rows[run[j]];
+    r.load_after = p.loadAt(j, F);
+    r.friction_impulse.setZero();
+    r.friction_impulse.head(r.nf) = p.f.segment(r.first_force, r.nf);
+    r.slip_after.setZero();
+    r.slip_after.head(r.nf) = p.acc.segment(r.first_force, r.nf);
+  }
+  return 1;
 }
 
-/// The touching contacts in the impact's set with friction rows: u.onset,
-/// each one's first unknown, F their friction rows. Whether any needs
-/// Coulomb's law (one sliding, or sticking impulses outside its cone).
-bool Simulator::Impl::frictionImpactCandidates(int& F) {
+bool Simulator::Impl::frictionImpactCandidates() {
   auto& u = *uni_;
-  u.onset.clear();
-  F = 0;
   bool needed = false;
-  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
-    UnilateralRow& r = u.rows[k];
-    if (!r.touching || !r.in_set || r.nf == 0) continue;
+  detail::gatherByIsland(u.islands, u.onset, u.onset_runs, [&](int k) {
+    const UnilateralRow& r = u.rows[k];
+    if (!r.touching || !r.in_set || r.nf == 0) return false;
     const auto& sr = cdata_->slide[r.c];
     double pt = 0;
     for (int i = 0; i < sr.n; ++i)
       pt += std::pow(u.impulse[cdata_->offset[r.c] + sr.row[i]] / sr.scale[i], 2);
     needed = needed || cdata_->isSliding(r.c) ||
              std::sqrt(pt) > r.mu * std::max(0.0, r.impulse) * (1 + 1e-9);
-    r.first_force = F;
-    F += r.nf;
-    u.onset.push_back(k);
-  }
+    return true;
+  });
   return needed;
 }
 
-/// The released contacts back to their rows; their modes as before unless
-/// `keep_modes`.
 void Simulator::Impl::releaseOnset(bool keep_modes) {
   auto& u = *uni_;
   for (int k : u.onset) {
@@ -143,16 +159,16 @@ void Simulator::Impl::releaseOnset(bool keep_modes) {
 /// The impact problem's maps at (t, q, v⁻), the friction rows released: the
 /// responses to unit friction impulses (V, W, N), Newton's law on the normal
 /// rows alone (v⁰ in u.vplus, Pₙ⁰ in p.ln0) and the slips s⁰ at v⁰ (p.a0).
-bool Simulator::Impl::frictionImpactMaps(int F, std::string& error) {
+bool Simulator::Impl::frictionImpactMaps(std::span<const int> run, int F, std::string& error) {
   auto& u = *uni_;
   auto& p = u.onset_problem;
-  const int K = static_cast<int>(u.onset.size());
+  const int K = static_cast<int>(run.size());
   // The responses at (t, q, v⁻): they depend on q only.
   v_ = u.vminus;
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  frictionUnitForces(u.onset, &UnilateralRow::first_force, p);
+  frictionUnitForces(run, &UnilateralRow::first_force, p);
   tau_.setZero();
-  if (!frictionResponses(t_, q_, v_, tau_, u.onset, &UnilateralRow::first_force, F, p, true)) {
+  if (!frictionResponses(t_, q_, v_, tau_, run, &UnilateralRow::first_force, F, p, true)) {
     error = "impact with friction: " + p.res.error;
     return false;
   }
@@ -164,11 +180,11 @@ bool Simulator::Impl::frictionImpactMaps(int F, std::string& error) {
     error = "impact with friction: the impulse solve failed: " + solver_->lastError();
     return false;
   }
-  for (int j = 0; j < K; ++j) p.ln0[j] = -u.impulse[u.rows[u.onset[j]].global];
+  for (int j = 0; j < K; ++j) p.ln0[j] = -u.impulse[u.rows[run[j]].global];
   // s⁰: the released rows' slips at v⁰.
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, u.vplus);
   for (int j = 0; j < K; ++j) {
-    const UnilateralRow& r = u.rows[u.onset[j]];
+    const UnilateralRow& r = u.rows[run[j]];
     p.a0.segment(r.first_force, r.nf) = cdata_->slide[r.c].slip.head(r.nf);
   }
   return true;
@@ -178,16 +194,13 @@ bool Simulator::Impl::frictionImpactMaps(int F, std::string& error) {
 /// impulses for the log and its mode after the impact. false (the impact
 /// undone) when they would pull a contact, `separating` naming it when it
 /// was at rest.
-bool Simulator::Impl::applyFrictionImpulses(int F, int& separating, std::string& error) {
+bool Simulator::Impl::applyFrictionImpulses(int& separating, std::string& error) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
-  auto& p = u.onset_problem;
-  const int K = static_cast<int>(u.onset.size());
-  for (int j = 0; j < K; ++j) {
-    const int k = u.onset[j];
+  for (int k : u.onset) {
     UnilateralRow& r = u.rows[k];
     const auto& sr = cdata_->slide[r.c];
-    const double pn = p.loadAt(j, F);
+    const double pn = r.load_after;
     if (pn < -o.force_tol) {
       releaseOnset(false);
       v_ = u.vstick;
@@ -200,9 +213,8 @@ bool Simulator::Impl::applyFrictionImpulses(int F, int& separating, std::string&
     r.impulse = pn;
     u.impulse[r.global] = -pn;
     for (int i = 0; i < sr.n; ++i)
-      u.impulse[cdata_->offset[r.c] + sr.row[i]] = -p.f[r.first_force + i] * sr.scale[i];
-    Vec3 slip = Vec3::Zero();
-    slip.head(r.nf) = p.acc.segment(r.first_force, r.nf);
+      u.impulse[cdata_->offset[r.c] + sr.row[i]] = -r.friction_impulse[i] * sr.scale[i];
+    const Vec3 slip = r.slip_after;
     const bool slides = slip.norm() > o.speed_tol;
     if (slides) {
       r.dir = slip / slip.norm();

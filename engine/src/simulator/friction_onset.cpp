@@ -47,60 +47,74 @@ namespace appell {
 using detail::UnilateralRow;
 
 /// Decides the modes and sliding directions of every closed contact with
-/// friction whose slip is zero at (t_, q_, v_), together (above); `forced`
-/// (a row index, or −1) slides. false with `error` when a solve fails; a
-/// sweep that does not settle leaves the modes as they were (the friction
-/// phase then decides them one at a time).
+/// friction whose slip is zero at (t_, q_, v_), together (above), island by
+/// island (islands.cpp); `forced` (a row index, or −1) slides. false with
+/// `error` when a solve fails; a sweep that does not settle leaves its
+/// island's modes as they were (the friction phase then decides them one at
+/// a time).
 bool Simulator::Impl::frictionOnset(int forced, std::string& error) {
   auto& u = *uni_;
   const ContactEventOptions& o = options_.contacts;
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  u.onset.clear();
-  int F = 0;
-  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
-    UnilateralRow& r = u.rows[k];
-    if (r.nf == 0 || r.creep > 0 || !cdata_->isActive(r.c)) continue;
-    if (k != forced && contactSlip(k).norm() > o.speed_tol) continue;
-    r.first_force = F;
-    F += r.nf;
-    u.onset.push_back(k);
-  }
-  const int K = static_cast<int>(u.onset.size());
-  if (K == 0) return true;
+  detail::gatherByIsland(u.islands, u.onset, u.onset_runs, [&](int k) {
+    const UnilateralRow& r = u.rows[k];
+    if (r.nf == 0 || r.creep > 0 || !cdata_->isActive(r.c)) return false;
+    return k == forced || contactSlip(k).norm() <= o.speed_tol;
+  });
+  if (u.onset.empty()) return true;
   // Release their friction rows.
-  for (int j = 0; j < K; ++j) {
-    UnilateralRow& r = u.rows[u.onset[j]];
-    u.was_sliding[u.onset[j]] = cdata_->isSliding(r.c);
+  for (int k : u.onset) {
+    UnilateralRow& r = u.rows[k];
+    u.was_sliding[k] = cdata_->isSliding(r.c);
     cdata_->setSliding(r.c, true);
     r.released = true;
   }
-  auto restore = [&] {
-    for (int j = 0; j < K; ++j) {
-      UnilateralRow& r = u.rows[u.onset[j]];
-      r.released = false;
-      cdata_->setSliding(r.c, u.was_sliding[u.onset[j]] != 0);
-    }
-  };
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-  auto& p = u.onset_problem;
-  frictionUnitForces(u.onset, &UnilateralRow::first_force, p);
   tau_.setZero();
   if (tau_fn_) tau_fn_(t_, q_, v_, tau_);
-  if (!frictionResponses(t_, q_, v_, tau_, u.onset, &UnilateralRow::first_force, F, p)) {
+  for (int i = 0; i + 1 < static_cast<int>(u.onset_runs.size()); ++i)
+    if (!frictionOnsetIsland(detail::runOf(u.onset, u.onset_runs, i), forced, error)) {
+      for (int k : u.onset)  // (the islands already decided keep their modes)
+        if (u.rows[k].released) {
+          u.rows[k].released = false;
+          cdata_->setSliding(u.rows[k].c, u.was_sliding[k] != 0);
+        }
+      return false;
+    }
+  return true;
+}
+
+/// One island's onset problem, its rows released by frictionOnset: solved,
+/// its rows restored, and its modes set when the sweeps settled.
+bool Simulator::Impl::frictionOnsetIsland(std::span<const int> run, int forced,
+                                          std::string& error) {
+  auto& u = *uni_;
+  const int K = static_cast<int>(run.size());
+  const int F = detail::numberUnknowns(u.rows, run, &UnilateralRow::first_force);
+  auto restore = [&] {
+    for (int k : run) {
+      UnilateralRow& r = u.rows[k];
+      r.released = false;
+      cdata_->setSliding(r.c, u.was_sliding[k] != 0);
+    }
+  };
+  auto& p = u.onset_problem;
+  frictionUnitForces(run, &UnilateralRow::first_force, p);
+  if (!frictionResponses(t_, q_, v_, tau_, run, &UnilateralRow::first_force, F, p)) {
     restore();
     error = "friction modes: " + p.res.error;
     return false;
   }
   // Block Gauss–Seidel, the loads updated as it goes.
   const bool settled = p.gaussSeidel(K, F, 10000, [&](int j) {
-    const UnilateralRow& r = u.rows[u.onset[j]];
+    const UnilateralRow& r = u.rows[run[j]];
     const int o0 = r.first_force, n = r.nf;
     const double radius = r.mu * std::max(0.0, p.loadAt(j, F));
     Mat3 H;
     Vec3 c;
     p.disk(o0, n, F, H, c);
     Vec3 fj = detail::diskMinimizer(H, c, n, radius);
-    if (u.onset[j] == forced && fj.norm() < radius) {
+    if (run[j] == forced && fj.norm() < radius) {
       // At its slip event: on the cone, along the sticking force found
       // (or the one it had).
       const Vec3 d = fj.norm() > 0 ? Vec3(fj / fj.norm()) : Vec3(-r.dir);
@@ -114,22 +128,22 @@ bool Simulator::Impl::frictionOnset(int forced, std::string& error) {
     ++counters_.friction_onset_unsettled;
     return true;
   }
-  setOnsetModes(forced, F);
+  setOnsetModes(run, forced, F);
   return true;
 }
 
-/// The onset's modes from its settled forces f: a contact on its cone whose
-/// slip accelerates slides along that acceleration, against its friction;
-/// `forced` slides; the others stick. Logs the changes.
-void Simulator::Impl::setOnsetModes(int forced, int F) {
+/// The onset's modes from one island's settled forces f: a contact on its
+/// cone whose slip accelerates slides along that acceleration, against its
+/// friction; `forced` slides; the others stick. Logs the changes.
+void Simulator::Impl::setOnsetModes(std::span<const int> run, int forced, int F) {
   auto& u = *uni_;
   auto& p = u.onset_problem;
-  const int K = static_cast<int>(u.onset.size());
+  const int K = static_cast<int>(run.size());
   p.acc.head(F) = p.a0.head(F);
   p.acc.head(F).noalias() += p.W.topLeftCorner(F, F) * p.f.head(F);
   const double atol = 1e-9 * std::max(1.0, p.acc.head(F).lpNorm<Eigen::Infinity>());
   for (int j = 0; j < K; ++j) {
-    const int k = u.onset[j];
+    const int k = run[j];
     UnilateralRow& r = u.rows[k];
     const int n = r.nf;
     Vec3 fj = Vec3::Zero(), aj = Vec3::Zero();

@@ -44,42 +44,59 @@ using detail::UnilateralRow;
 int Simulator::Impl::overconstrainedContact(double t, const VecX& q, const VecX& v) {
   auto& u = *uni_;
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t, q, v);
-  u.onset.clear();  // capacity reserved: no allocation
-  int F = 0;
-  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
-    UnilateralRow& r = u.rows[k];
-    if (r.nf == 0 || !cdata_->isActive(r.c) || cdata_->isSliding(r.c)) continue;
-    r.first_force = F;
-    F += r.nf;
-    u.onset.push_back(k);
-  }
-  const int K = static_cast<int>(u.onset.size());
-  if (K == 0) return -1;
+  detail::gatherByIsland(u.islands, u.onset, u.onset_runs, [&](int k) {
+    const UnilateralRow& r = u.rows[k];
+    return r.nf > 0 && cdata_->isActive(r.c) && !cdata_->isSliding(r.c);
+  });
+  if (u.onset.empty()) return -1;
   for (int k : u.onset) {
     cdata_->setSliding(u.rows[k].c, true);
     u.rows[k].released = true;
   }
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t, q, v);
-  auto& p = u.onset_problem;
-  frictionUnitForces(u.onset, &UnilateralRow::first_force, p);
   tau_.setZero();
   if (tau_fn_) tau_fn_(t, q, v, tau_);
-  const bool ok = frictionResponses(t, q, v, tau_, u.onset, &UnilateralRow::first_force, F, p);
+  // The contact whose cone the unbounded sticking force fills first, over
+  // every island (each its own W: islands.cpp).
+  int pick = -1;
+  double worst = 0;
+  Vec3 dir = Vec3::Zero();
+  for (int i = 0; i + 1 < static_cast<int>(u.onset_runs.size()) && pick != -2; ++i) {
+    const int k = overconstrainedIsland(t, q, v, detail::runOf(u.onset, u.onset_runs, i), worst, dir);
+    if (k != -1) pick = k;
+  }
   for (int k : u.onset) {
     cdata_->setSliding(u.rows[k].c, false);
     u.rows[k].released = false;
   }
-  if (!ok || !p.W.topLeftCorner(F, F).allFinite() || !p.a0.head(F).allFinite()) return -1;
+  if (pick < 0) return -1;
+  // Its friction along −gⱼ: it slips along +gⱼ.
+  u.rows[pick].dir = dir;
+  return pick;
+}
 
-  // W's round-off null space, on the storage sized for every friction row:
-  // the rows past F carry an identity at W's scale (never null).
+/// One island's over-constraint: the row (and its slip direction, in `dir`)
+/// whose demand-to-budget ratio exceeds `worst` (which it raises), −1 when
+/// none does, −2 when a solve failed (no contact is picked then).
+int Simulator::Impl::overconstrainedIsland(double t, const VecX& q, const VecX& v,
+                                           std::span<const int> run, double& worst, Vec3& dir) {
+  auto& u = *uni_;
+  auto& p = u.onset_problem;
+  const int K = static_cast<int>(run.size());
+  const int F = detail::numberUnknowns(u.rows, run, &UnilateralRow::first_force);
+  frictionUnitForces(run, &UnilateralRow::first_force, p);
+  const bool ok = frictionResponses(t, q, v, tau_, run, &UnilateralRow::first_force, F, p);
+  if (!ok || !p.W.topLeftCorner(F, F).allFinite() || !p.a0.head(F).allFinite()) return -2;
+
+  // W's round-off null space, on the storage sized for the largest island's
+  // friction rows: the rows past F carry an identity at W's scale (never null).
   const int nf = static_cast<int>(u.over_W.rows());
   const double wmax = std::max(p.W.topLeftCorner(F, F).cwiseAbs().maxCoeff(), 1e-300);
   u.over_W.setZero();
   u.over_W.topLeftCorner(F, F) = 0.5 * (p.W.topLeftCorner(F, F) + p.W.topLeftCorner(F, F).transpose());
   for (int i = F; i < nf; ++i) u.over_W(i, i) = wmax;
   u.over_eig.compute(u.over_W);
-  if (u.over_eig.info() != Eigen::Success) return -1;
+  if (u.over_eig.info() != Eigen::Success) return -2;
   const VecX& w = u.over_eig.eigenvalues();
   const MatX& Y = u.over_eig.eigenvectors();
   u.over_g.setZero();
@@ -90,24 +107,20 @@ int Simulator::Impl::overconstrainedContact(double t, const VecX& q, const VecX&
   if (!(u.over_g.head(F).lpNorm<Eigen::Infinity>() > floor)) return -1;
 
   int pick = -1;
-  double worst = 0;
   for (int j = 0; j < K; ++j) {
-    const UnilateralRow& r = u.rows[u.onset[j]];
+    const UnilateralRow& r = u.rows[run[j]];
     const double demand = u.over_g.segment(r.first_force, r.nf).norm();
     const double budget = r.mu * std::max(p.ln0[j], 0.0);
     // (A contact with no load holds nothing: it is the first to go.)
     const double ratio = budget > 0 ? demand / budget : (demand > 0 ? HUGE_VAL : 0.0);
     if (ratio > worst) {
       worst = ratio;
-      pick = j;
+      pick = run[j];
+      dir.setZero();
+      dir.head(r.nf) = u.over_g.segment(r.first_force, r.nf).normalized();
     }
   }
-  if (pick < 0) return -1;
-  UnilateralRow& r = u.rows[u.onset[pick]];
-  // Its friction along −gⱼ: it slips along +gⱼ.
-  r.dir.setZero();
-  r.dir.head(r.nf) = u.over_g.segment(r.first_force, r.nf).normalized();
-  return u.onset[pick];
+  return pick;
 }
 
 }  // namespace appell

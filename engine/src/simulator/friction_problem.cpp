@@ -73,7 +73,7 @@ Vec3 detail::diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r) 
 /// Column first + i of p.U: the generalized force of a unit force along
 /// friction row i of each of `ks`'s rows (row k's first unknown at k.*first),
 /// with data_ at the state's kinematics.
-void Simulator::Impl::frictionUnitForces(const std::vector<int>& ks, int UnilateralRow::*first,
+void Simulator::Impl::frictionUnitForces(std::span<const int> ks, int UnilateralRow::*first,
                                    detail::FrictionProblem& p) {
   auto& u = *uni_;
   for (int k : ks) {
@@ -100,7 +100,7 @@ void Simulator::Impl::frictionUnitForces(const std::vector<int>& ks, int Unilate
 /// the scale of the loads (the map is affine: any scale is exact up to
 /// round-off relative to τ). false with p.res.error when a solve fails.
 bool Simulator::Impl::frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,
-                                  const std::vector<int>& ks, int UnilateralRow::*first, int F,
+                                  std::span<const int> ks, int UnilateralRow::*first, int F,
                                   detail::FrictionProblem& p, bool with_velocities) {
   const int K = static_cast<int>(ks.size());
   auto respond = [&](const VecX& tau_prime, Eigen::Ref<VecX> acc, Eigen::Ref<VecX> load) {

@@ -155,11 +155,11 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
 // sweeps): its force on the disk of radius μₖλₙ, at the settled direction's
 // minimizer while its slip is slow beside the disk's answer, or along its
 // slip (its force then known, still affine in its load). Returns the radius.
-double Simulator::Impl::settleCandidate(int j, int F) {
+double Simulator::Impl::settleCandidate(std::span<const int> run, int j, int F) {
   auto& u = *uni_;
   auto& p = u.settle_problem;
   const double floor = 10 * options_.contacts.speed_tol;
-  UnilateralRow& r = u.rows[u.settle[j]];
+  UnilateralRow& r = u.rows[run[j]];
   const int o0 = r.settle_force, n = r.nf;
   const double radius = r.mu_k * std::max(0.0, p.loadAt(j, F));
   const double slip = cdata_->slide[r.c].slip.norm();
@@ -184,52 +184,40 @@ double Simulator::Impl::settleCandidate(int j, int F) {
 // reported on their friction rows' multipliers.
 void Simulator::Impl::recordSettledForces(ConstrainedResult& out, SolveOutputs outputs) {
   auto& u = *uni_;
-  const auto& p = u.settle_problem;
-  for (int j = 0; j < static_cast<int>(u.settle.size()); ++j) {
-    UnilateralRow& r = u.rows[u.settle[j]];
+  for (int k : u.settle) {
+    UnilateralRow& r = u.rows[k];
     const auto& sr = cdata_->slide[r.c];
-    const double fn = p.f.segment(r.settle_force, r.nf).norm();
+    const double fn = r.settled.head(r.nf).norm();
     if (fn > 0) {
       r.dir.setZero();
-      r.dir.head(r.nf) = -p.f.segment(r.settle_force, r.nf) / fn;
+      r.dir.head(r.nf) = -r.settled.head(r.nf) / fn;
     }
     if (outputs == SolveOutputs::All)
       for (int i = 0; i < sr.n; ++i)
-        out.lambda[cdata_->offset[r.c] + sr.row[i]] = p.f[r.settle_force + i] * sr.scale[i];
+        out.lambda[cdata_->offset[r.c] + sr.row[i]] = r.settled[i] * sr.scale[i];
   }
 }
 
-bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
-                              ConstrainedResult& out, SolveOutputs outputs) {
+// One island's candidates: their forces (kept in r.settled), added to
+// u.settle_tau, and the power they take added to `power`. false with
+// out.error when a solve fails; true with out.ok false when the sweeps did
+// not settle.
+bool Simulator::Impl::settleIsland(double t, const VecX& q, const VecX& v, const VecX& tau,
+                                   std::span<const int> run, double& power,
+                                   ConstrainedResult& out) {
   auto& u = *uni_;
-  u.settle.clear();  // capacity reserved: no allocation
-  int F = 0;
-  for (int k = 0; k < static_cast<int>(u.rows.size()); ++k) {
-    UnilateralRow& r = u.rows[k];
-    if (!r.settling) continue;
-    r.settle_force = F;
-    F += r.nf;
-    r.released = true;  // its force is this solve's unknown
-    u.settle.push_back(k);
-  }
-  const int K = static_cast<int>(u.settle.size());
-  auto restore = [&] {
-    for (int j = 0; j < K; ++j) {
-      u.rows[u.settle[j]].released = false;
-      u.rows[u.settle[j]].settling = false;
-    }
-  };
   auto& p = u.settle_problem;
-  frictionUnitForces(u.settle, &UnilateralRow::settle_force, p);
+  const int K = static_cast<int>(run.size());
+  const int F = detail::numberUnknowns(u.rows, run, &UnilateralRow::settle_force);
+  frictionUnitForces(run, &UnilateralRow::settle_force, p);
   // (The other sliding contacts superposed as usual in each solve.)
-  if (!frictionResponses(t, q, v, tau, u.settle, &UnilateralRow::settle_force, F, p)) {
-    restore();
+  if (!frictionResponses(t, q, v, tau, run, &UnilateralRow::settle_force, F, p)) {
     out.ok = false;
     out.error = "sliding friction (settled directions): " + p.res.error;
     return false;
   }
   for (int j = 0; j < K; ++j) {
-    const UnilateralRow& r = u.rows[u.settle[j]];
+    const UnilateralRow& r = u.rows[run[j]];
     Mat3 H = Mat3::Zero();
     H.topLeftCorner(r.nf, r.nf) = p.W.block(r.settle_force, r.settle_force, r.nf, r.nf);
     H = 0.5 * (H + H.transpose()).eval();
@@ -239,9 +227,42 @@ bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, cons
   // sweeps. A candidate slow to settle, or whose minimizer is inside its
   // circle, slides along its slip (its force then known, still affine in
   // its load).
-  const bool settled = p.gaussSeidel(K, F, 1000, [&](int j) { return settleCandidate(j, F); });
-  if (!settled) {
-    // Along their slips, as without this path (the loads still exact).
+  out.ok = p.gaussSeidel(K, F, 1000, [&](int j) { return settleCandidate(run, j, F); });
+  if (!out.ok) return true;
+  u.settle_tau.noalias() += p.U.leftCols(F) * p.f.head(F);
+  for (int c = 0; c < F; ++c) power -= p.f[c] * p.U.col(c).dot(v);
+  for (int k : run) {
+    UnilateralRow& r = u.rows[k];
+    r.settled.setZero();
+    r.settled.head(r.nf) = p.f.segment(r.settle_force, r.nf);
+  }
+  return true;
+}
+
+bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
+                              ConstrainedResult& out, SolveOutputs outputs) {
+  auto& u = *uni_;
+  detail::gatherByIsland(u.islands, u.settle, u.settle_runs, [&](int k) {
+    if (!u.rows[k].settling) return false;
+    u.rows[k].released = true;  // its force is this solve's unknown
+    return true;
+  });
+  auto restore = [&] {
+    for (int k : u.settle) {
+      u.rows[k].released = false;
+      u.rows[k].settling = false;
+    }
+  };
+  u.settle_tau = tau;
+  double power = 0;
+  for (int i = 0; i + 1 < static_cast<int>(u.settle_runs.size()); ++i) {
+    if (!settleIsland(t, q, v, tau, detail::runOf(u.settle, u.settle_runs, i), power, out)) {
+      restore();
+      return false;
+    }
+    if (out.ok) continue;
+    // Unsettled: every contact along its slip, as without this path (the
+    // loads still exact).
     ++counters_.settle_unsettled;
     restore();
     u.settle_off = true;
@@ -250,14 +271,10 @@ bool Simulator::Impl::solveSettling(double t, const VecX& q, const VecX& v, cons
     return ok;
   }
   // The last solve, with the candidates' forces applied.
-  p.tau = tau;
-  p.tau.noalias() += p.U.leftCols(F) * p.f.head(F);
-  if (!solveDynamics(t, q, v, p.tau, out, outputs)) {
+  if (!solveDynamics(t, q, v, u.settle_tau, out, outputs)) {
     restore();
     return false;
   }
-  double power = 0;
-  for (int c = 0; c < F; ++c) power -= p.f[c] * p.U.col(c).dot(v);
   u.friction_power += power;  // beside the other sliding contacts'
   recordSettledForces(out, outputs);
   restore();

@@ -73,23 +73,32 @@ struct Simulator::Impl {
   bool solveSettling(double t, const VecX& q, const VecX& v, const VecX& tau,
                      ConstrainedResult& out, SolveOutputs outputs);
   bool markSliding(const VecX& v);
-  void slidingFrictionColumns();
-  bool slidingLoadResponses(const VecX& q, const VecX& v, const VecX& tau, ConstrainedResult& out);
-  double settleCandidate(int j, int F);
+  void slidingFrictionColumns(std::span<const int> run);
+  bool slidingLoadResponses(const VecX& q, const VecX& v, const VecX& tau, int first,
+                            std::span<const int> run, ConstrainedResult& out);
+  bool slidingNormalLoads(const VecX& q, const VecX& v, const VecX& tau, int first,
+                          std::span<const int> run, ConstrainedResult& out);
+  bool settleIsland(double t, const VecX& q, const VecX& v, const VecX& tau,
+                    std::span<const int> run, double& power, ConstrainedResult& out);
+  double settleCandidate(std::span<const int> run, int j, int F);
   void recordSettledForces(ConstrainedResult& out, SolveOutputs outputs);
-  void frictionUnitForces(const std::vector<int>& rows, int detail::UnilateralRow::*first,
+  void frictionUnitForces(std::span<const int> rows, int detail::UnilateralRow::*first,
                           detail::FrictionProblem& p);
   bool frictionResponses(double t, const VecX& q, const VecX& v, const VecX& tau,
-                         const std::vector<int>& rows, int detail::UnilateralRow::*first, int F,
+                         std::span<const int> rows, int detail::UnilateralRow::*first, int F,
                          detail::FrictionProblem& p, bool with_velocities = false);
   /// An impact's friction impulses (friction_impact.cpp). When they would
   /// pull a contact that was at rest in the set, `separating` names it.
   bool frictionImpact(std::string& error, int& separating);
-  bool frictionImpactCandidates(int& F);
-  bool frictionImpactMaps(int F, std::string& error);
-  bool applyFrictionImpulses(int F, int& separating, std::string& error);
+  bool frictionImpactCandidates();
+  bool frictionImpactMaps(std::span<const int> run, int F, std::string& error);
+  int frictionImpactIsland(std::span<const int> run, bool first, std::string& error);
+  bool applyFrictionImpulses(int& separating, std::string& error);
   void releaseOnset(bool keep_modes);
-  void setOnsetModes(int forced, int F);
+  bool frictionOnsetIsland(std::span<const int> run, int forced, std::string& error);
+  void setOnsetModes(std::span<const int> run, int forced, int F);
+  int overconstrainedIsland(double t, const VecX& q, const VecX& v, std::span<const int> run,
+                            double& worst, Vec3& dir);
   void shiftImpactTargets();
   Vec3 contactSlip(int k) const;
   std::string rigidRollingHint() const;

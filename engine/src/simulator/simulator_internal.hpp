@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -50,6 +51,10 @@ struct ImpactState {
   bool touching = false, in_set = false, was_closed = false, lifting = false, touching_down = false;
   bool bounced = false;   // rebounded at this event: open, not a force candidate
   bool separated = false; // left the impact's set: its friction impulses would pull it
+  // An impact's friction solution (friction_impact.cpp), kept per row until
+  // every island's is found: friction impulse, slip after, normal impulse.
+  Vec3 friction_impulse = Vec3::Zero(), slip_after = Vec3::Zero();
+  double load_after = 0;
 };
 
 /// A unilateral row's Coulomb friction (friction.cpp and the friction_*
@@ -79,6 +84,7 @@ struct FrictionState {
 struct SettlingState {
   bool settling = false;
   int settle_force = 0;
+  Vec3 settled = Vec3::Zero();  // its force, kept until the last solve reports it
 };
 
 /// A contact's piece of a piecewise support and its pair (contact_features.cpp).
@@ -112,17 +118,64 @@ struct LocatedEvent {
   double hi = 0;
 };
 
+/// The unilateral rows grouped by the bodies their forces can move
+/// (islands.cpp): island i's rows are rows[start[i] .. start[i + 1]), in
+/// their order; each friction problem is solved island by island, on
+/// storage sized for the largest island.
+struct Islands {
+  std::vector<int> start, rows, of_row;
+  int max_friction_contacts = 0, max_friction_rows = 0;
+  int count() const { return static_cast<int>(start.size()) - 1; }
+};
+
+Islands findIslands(const Model& model, const ConstraintList& constraints,
+                    const ConstraintData& cd, const std::vector<UnilateralRow>& rows);
+
+/// A problem's candidates island by island: `list` gets the rows `pick`
+/// selects (pick sees every row once, island by island), `runs` the start of
+/// each island that has some (runs.back() == list.size()). Capacities
+/// reserved at construction: no allocation.
+template <class Pick>
+void gatherByIsland(const Islands& is, std::vector<int>& list, std::vector<int>& runs, Pick&& pick) {
+  list.clear();
+  runs.clear();
+  runs.push_back(0);
+  for (int i = 0; i < is.count(); ++i) {
+    for (int j = is.start[i]; j < is.start[i + 1]; ++j)
+      if (pick(is.rows[j])) list.push_back(is.rows[j]);
+    if (static_cast<int>(list.size()) > runs.back()) runs.push_back(static_cast<int>(list.size()));
+  }
+}
+
+/// Run i of a gathered list.
+inline std::span<const int> runOf(const std::vector<int>& list, const std::vector<int>& runs, int i) {
+  return std::span<const int>(list.data() + runs[i], runs[i + 1] - runs[i]);
+}
+
+/// Numbers one run's friction unknowns from 0 (each row's first at r.*first);
+/// returns their count.
+inline int numberUnknowns(std::vector<UnilateralRow>& rows, std::span<const int> run,
+                          int UnilateralRow::*first) {
+  int F = 0;
+  for (int k : run) {
+    rows[k].*first = F;
+    F += rows[k].nf;
+  }
+  return F;
+}
+
 struct UnilateralState {
   std::vector<UnilateralRow> rows;
+  Islands islands;
   VecX q0, v0, vplus, vminus, vdot, impulse;
   double t0 = 0;
   ConstrainedResult res;
   int zero_events = 0;    // consecutive events at the very start of a step
   // Sliding friction by superposition (friction.cpp), sized for every
   // contact with friction rows and finite μ.
-  std::vector<int> sliding;   // rows (indices into `rows`) sliding in this solve
-  MatX G, J, R;               // nv × k friction forces per unit normal load; 6 × nv; k × k
-  VecX lam0, s, tau_f;
+  std::vector<int> sliding, sliding_runs;  // rows sliding in this solve, island by island
+  MatX G, J, R;               // nv × k friction forces per unit normal load; 6 × nv; k × k (one island)
+  VecX lam0, s, tau_f, tau_unit;
   double friction_power = 0;  // −vᵀ Σ sⱼ Gⱼ of the last solve: the power friction takes
   ConstrainedResult unit;
   Eigen::PartialPivLU<MatX> lu;
@@ -130,16 +183,18 @@ struct UnilateralState {
   // candidates, their generalized forces per unit row force (nv × F), the
   // slip accelerations' and normal loads' responses W (F × F), N (K × F),
   // the free terms, the forces and the modes before.
-  std::vector<int> onset;
+  std::vector<int> onset, onset_runs;
   FrictionProblem onset_problem;
   std::vector<char> was_sliding;
   // Sliding contacts on their settled directions (friction_settled.cpp): the
   // same unknowns, their own storage (an onset's solves may need it).
-  std::vector<int> settle;
+  std::vector<int> settle, settle_runs;
+  VecX settle_tau;            // τ with every island's settled forces
   bool settle_off = false;    // this solve slides every contact along its slip
   FrictionProblem settle_problem;
   VecX swmax;                 // per candidate: the largest eigenvalue of its W block
   VecX vstick;                // an impact's post-impact velocity with every contact sticking
+  VecX vsum;                  // an impact's v⁰ + Σ V P over the islands (friction_impact.cpp)
   // Over-constrained sticking contacts (friction_overconstrained.cpp), sized
   // for every friction row: W padded, its eigen-solver, the part g of the
   // free slip acceleration in W's null space.

@@ -79,6 +79,7 @@ void Simulator::Impl::setUpUnilateral() {
   for (const auto& r : uni_->rows)  // regularized friction: closed means sliding
     if (cdata_->regularized[r.c] && cdata_->isActive(r.c)) cdata_->setSliding(r.c, true);
   linkPointGroups();
+  uni_->islands = detail::findIslands(model_, constraints_, *cdata_, uni_->rows);
   sizeUnilateralWorkspace();
 }
 
@@ -103,7 +104,9 @@ void Simulator::Impl::linkPointGroups() {
   }
 }
 
-/// Every buffer of the unilateral stages, at its largest size.
+/// Every buffer of the unilateral stages, at its largest size: the friction
+/// problems' for the largest island (islands.cpp), so that memory grows with
+/// the scene, not with the square of its contacts.
 void Simulator::Impl::sizeUnilateralWorkspace() {
   auto& u = *uni_;
   u.q0 = q_;
@@ -118,26 +121,33 @@ void Simulator::Impl::sizeUnilateralWorkspace() {
   events_.reserve(64);
   int kf = 0;
   for (const auto& r : u.rows) kf += r.nf > 0 ? 1 : 0;
+  const int island_kf = u.islands.max_friction_contacts;
+  const int island_nf = u.islands.max_friction_rows;
+  const size_t runs = static_cast<size_t>(u.islands.count()) + 1;
   u.sliding.reserve(u.rows.size());
-  u.G = MatX::Zero(model_.nv, kf);
+  u.sliding_runs.reserve(runs);
+  u.G = MatX::Zero(model_.nv, island_kf);
   u.J = MatX::Zero(6, model_.nv);
-  u.R = MatX::Zero(kf, kf);
+  u.R = MatX::Zero(island_kf, island_kf);
   u.lam0 = VecX::Zero(kf);
   u.s = VecX::Zero(kf);
   u.tau_f = VecX::Zero(model_.nv);
+  u.tau_unit = VecX::Zero(model_.nv);
   u.unit = u.res;
-  int nf = 0;
-  for (const auto& r : u.rows) nf += r.nf;
   u.onset.reserve(u.rows.size());
+  u.onset_runs.reserve(runs);
   u.was_sliding.assign(u.rows.size(), 0);
-  u.onset_problem.size(model_.nv, nf, kf, u.res);
+  u.onset_problem.size(model_.nv, island_nf, island_kf, u.res);
   u.settle.reserve(u.rows.size());
-  u.settle_problem.size(model_.nv, nf, kf, u.res);
-  u.swmax = VecX::Zero(kf);
+  u.settle_runs.reserve(runs);
+  u.settle_tau = VecX::Zero(model_.nv);
+  u.settle_problem.size(model_.nv, island_nf, island_kf, u.res);
+  u.swmax = VecX::Zero(island_kf);
   u.vstick = VecX::Zero(model_.nv);
-  u.over_W = MatX::Zero(nf, nf);
-  u.over_g = VecX::Zero(nf);
-  u.over_eig = Eigen::SelfAdjointEigenSolver<MatX>(nf);
+  u.vsum = VecX::Zero(model_.nv);
+  u.over_W = MatX::Zero(island_nf, island_nf);
+  u.over_g = VecX::Zero(island_nf);
+  u.over_eig = Eigen::SelfAdjointEigenSolver<MatX>(island_nf);
   u.feature_ahead.assign(u.rows.size(), -1);
 }
 
