@@ -11,7 +11,7 @@
 #                             link, the last tests). The benchmarks are not built
 #                             here: scripts/bench.sh builds and runs them.
 #   scripts/test.sh --quick   the fast local loop: the C++ tests only, in their own
-#                             build (build-quick: -O1, no Python, viewer
+#                             build (build-quick: clang, -O1, no Python, viewer
 #                             or sanitizers); SANITIZE=0 keeps the Release suite
 #                             and skips only the sanitized part.
 # Extra arguments go to ctest (e.g. -R Friction). Times on 2 cores, and why
