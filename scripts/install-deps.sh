@@ -5,6 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
+  clang                  # scripts/test.sh compiles its builds with clang (README, Building)
   libeigen3-dev          # Eigen 3.4: dense linear algebra
   libfcl-dev libccd-dev  # FCL 0.7 + libccd: collision queries
   libqhull-dev           # Qhull: convex hulls of mesh contact shapes

@@ -11,30 +11,40 @@
 #   and `appell run` end to end (4 programs, 5 min of the ~8 this takes on
 #   2 cores is the sanitized library). The whole suite: SANITIZE_ALL=1.
 #   scripts/sanitize.sh --build  only configure and build (the subset, `appell`
-#   and the two fuzz targets): scripts/test.sh runs this beside the Release
-#   build, at lower priority, then this script again for the runs.
+#                                and the two fuzz targets)
+#   scripts/sanitize.sh --test   configure, build and run the subset, no fuzzing:
+#                                scripts/test.sh runs this beside the Release
+#                                build, at lower priority, so the sanitized
+#                                tests run while the Release build still compiles
+#   scripts/sanitize.sh --fuzz   only the two fuzz runs (built before): test.sh
+#                                runs them after the Release tests, on both cores
 set -euo pipefail
 cd "$(dirname "$0")/.."
+step=${1:-all}
+case "$step" in all|--build|--test|--fuzz) ;; *) echo "sanitize.sh: unknown option $step" >&2; exit 2;; esac
 bash scripts/install-deps.sh
 # test_failures: the files named in tests/CMakeLists.txt's group of that name.
 SUBSET=(test_failures test_core_allocations test_simulator_alloc test_tree_solver_alloc)
 FUZZERS=(fuzz_scene_loader fuzz_mesh_loader)
-bash scripts/configure-asan.sh
-# One ninja run for everything this script needs: the fuzz targets' sources
-# compile beside the tests' instead of after the test runs.
-if [ "${SANITIZE_ALL:-0}" = 1 ]; then
-  cmake --build build-asan -j"$(nproc)"
-  filter=()
-else
-  cmake --build build-asan -j"$(nproc)" --target "${SUBSET[@]}" appell_cli "${FUZZERS[@]}"
-  # Every test carries its executable's name as a label (tests/CMakeLists.txt).
-  filter=(-L "^($(IFS='|'; echo "${SUBSET[*]}"))\$")
+if [ "$step" != --fuzz ]; then
+  bash scripts/configure-asan.sh
+  # One ninja run for everything this script needs: the fuzz targets' sources
+  # compile beside the tests' instead of after the test runs.
+  if [ "${SANITIZE_ALL:-0}" = 1 ]; then
+    cmake --build build-asan -j"$(nproc)"
+    filter=()
+  else
+    cmake --build build-asan -j"$(nproc)" --target "${SUBSET[@]}" appell_cli "${FUZZERS[@]}"
+    # Every test carries its executable's name as a label (tests/CMakeLists.txt).
+    filter=(-L "^($(IFS='|'; echo "${SUBSET[*]}"))\$")
+  fi
+  [ "$step" = --build ] && exit 0
+  # Leaks inside third-party libraries are suppressed by name (fuzz/lsan.supp).
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp
+  export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E 'package_consumer|viewer|python' "${filter[@]}"
 fi
-[ "${1:-}" = --build ] && exit 0
-# Leaks inside third-party libraries are suppressed by name (fuzz/lsan.supp).
-export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp
-export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E 'package_consumer|viewer|python' "${filter[@]}"
+[ "$step" = --test ] && exit 0
 # A fixed seed (FUZZ_SEED, default 1): CI explores the same inputs every run,
 # so a red CI is a change's doing and reproduces; scripts/fuzz.sh alone draws
 # a new seed each time, for exploring.

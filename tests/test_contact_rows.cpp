@@ -472,10 +472,17 @@ TEST(ContactRows, AccelerationTermsMatchFiniteDifferencesOnTerrainEdgesAndVertic
           pose.R = randomQuat(rng).toRotationMatrix();
           if (std::holds_alternative<Disk>(shape) || std::holds_alternative<Torus>(shape)) {
             // Wheels roughly upright with the axle along the ridge's normal plane.
-            pose.R = axisAngle(Vec3::UnitZ(), uniform(rng, -0.4, 0.4)) *
-                     axisAngle(Vec3::UnitX(), uniform(rng, -0.3, 0.3));
+            // One draw per statement, the tilt first (the order g++ drew
+            // the former product's factors in), so every compiler tests the
+            // same poses.
+            const double tilt = uniform(rng, -0.3, 0.3);
+            const double heading = uniform(rng, -0.4, 0.4);
+            pose.R = axisAngle(Vec3::UnitZ(), heading) * axisAngle(Vec3::UnitX(), tilt);
           }
-          pose.p = Vec3(uniform(rng, -0.01, 0.01), vertex ? uniform(rng, -0.01, 0.01) : uniform(rng, -1, 1), 0.3);
+          // Along the ridge (y) drawn before across it (x): g++'s order too.
+          const double along_ridge = vertex ? uniform(rng, -0.01, 0.01) : uniform(rng, -1, 1);
+          const double across_ridge = uniform(rng, -0.01, 0.01);
+          pose.p = Vec3(across_ridge, along_ridge, 0.3);
           ContactGeometry g;
           for (int it = 0; it < 5; ++it) {
             c->geometry(pose, Vec6::Zero(), 0.0, g);

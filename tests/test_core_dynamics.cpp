@@ -55,28 +55,26 @@ Model allJointTypesTree(bool floating_base, std::mt19937& rng) {
   using test::randomPlacement;
   using test::randomUnit;
   ModelBuilder b;
-  const int root = b.addBody("root", -1, randomPlacement(rng),
-                             floating_base ? JointType::Floating : JointType::Revolute,
-                             randomUnit(rng), randomInertia(rng));
-  const int rev = b.addBody("rev", root, randomPlacement(rng), JointType::Revolute,
-                            randomUnit(rng), randomInertia(rng));
-  const int cont = b.addBody("cont", rev, randomPlacement(rng), JointType::Continuous,
-                             randomUnit(rng), randomInertia(rng));
-  b.addBody("pris", cont, randomPlacement(rng), JointType::Prismatic, randomUnit(rng),
-            randomInertia(rng));
-  const int planar = b.addBody("planar", root, randomPlacement(rng), JointType::Planar,
-                               randomUnit(rng), randomInertia(rng));
-  const int ball = b.addBody("ball", planar, randomPlacement(rng), JointType::Ball,
-                             randomUnit(rng), randomInertia(rng));
-  b.addBody("free", ball, randomPlacement(rng), JointType::Floating, randomUnit(rng),
-            randomInertia(rng));
-  b.addBody("fixed", rev, randomPlacement(rng), JointType::Fixed, randomUnit(rng),
-            randomInertia(rng));
-  b.addBody("sensor", cont, randomPlacement(rng), JointType::Fixed, randomUnit(rng), Inertia{});
-  const int massless = b.addBody("massless_link", root, randomPlacement(rng),
-                                 JointType::Revolute, randomUnit(rng), Inertia{});
-  b.addBody("payload", massless, randomPlacement(rng), JointType::Revolute, randomUnit(rng),
-            randomInertia(rng));
+  // One draw per statement, the last argument first (the order g++ drew
+  // them in when they were one argument list, which C++ leaves to the
+  // compiler): every compiler builds the same tree.
+  auto add = [&](const std::string& name, int parent, JointType type, bool massless = false) {
+    const Inertia inertia = massless ? Inertia{} : randomInertia(rng);
+    const Vec3 axis = randomUnit(rng);
+    const SE3 placement = randomPlacement(rng);
+    return b.addBody(name, parent, placement, type, axis, inertia);
+  };
+  const int root = add("root", -1, floating_base ? JointType::Floating : JointType::Revolute);
+  const int rev = add("rev", root, JointType::Revolute);
+  const int cont = add("cont", rev, JointType::Continuous);
+  add("pris", cont, JointType::Prismatic);
+  const int planar = add("planar", root, JointType::Planar);
+  const int ball = add("ball", planar, JointType::Ball);
+  add("free", ball, JointType::Floating);
+  add("fixed", rev, JointType::Fixed);
+  add("sensor", cont, JointType::Fixed, true);
+  const int massless = add("massless_link", root, JointType::Revolute, true);
+  add("payload", massless, JointType::Revolute);
   return b.build();
 }
 

@@ -71,7 +71,8 @@ struct Case {
 Case randomCase(std::mt19937& rng, bool redundant) {
   std::uniform_int_distribution<int> nb(1, 6), coin(0, 1);
   Case c;
-  c.model = test::randomTree(nb(rng), coin(rng) == 1, rng);
+  const bool floating_base = coin(rng) == 1;  // before the size: g++'s order as arguments
+  c.model = test::randomTree(nb(rng), floating_base, rng);
   const int nc = std::uniform_int_distribution<int>(1, std::min(3, c.model.nbodies))(rng);
   std::vector<std::vector<Vec6>> rows;
   for (int k = 0; k < nc; ++k) {

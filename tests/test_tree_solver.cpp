@@ -171,10 +171,15 @@ TEST(TreeSolver, CompliantRowBeyondTheParentsSixRows) {
   for (double sigma : {2e-2, 5e-3}) {
     for (int rep = 0; rep < 4; ++rep) {
       ModelBuilder b;
-      b.addBody("free", -1, randomPlacement(rng), JointType::Floating, Vec3::UnitZ(),
-                randomInertia(rng));
-      b.addBody("leaf", 0, randomPlacement(rng), JointType::Revolute, randomUnit(rng),
-                randomInertia(rng));
+      // One draw per statement, the last argument first (g++'s order when
+      // they were one argument list): every compiler builds the same bodies.
+      const Inertia free_inertia = randomInertia(rng);
+      const SE3 free_placement = randomPlacement(rng);
+      b.addBody("free", -1, free_placement, JointType::Floating, Vec3::UnitZ(), free_inertia);
+      const Inertia leaf_inertia = randomInertia(rng);
+      const Vec3 leaf_axis = randomUnit(rng);
+      const SE3 leaf_placement = randomPlacement(rng);
+      b.addBody("leaf", 0, leaf_placement, JointType::Revolute, leaf_axis, leaf_inertia);
       System s;
       s.model = b.build();
       s.q = randomConfiguration(s.model, rng);
@@ -296,10 +301,18 @@ TEST(TreeSolver, InconsistentRowsSpreadOverATree) {
   // rows meet, and both constraints are named.
   ModelBuilder b;
   std::mt19937 rng(16);
-  b.addBody("base", -1, randomPlacement(rng), JointType::Revolute, randomUnit(rng),
-            randomInertia(rng));
-  b.addBody("plate", 0, randomPlacement(rng), JointType::Fixed, Vec3::UnitZ(), randomInertia(rng));
-  b.addBody("tool", 1, randomPlacement(rng), JointType::Fixed, Vec3::UnitZ(), randomInertia(rng));
+  // One draw per statement, the last argument first (g++'s order when they
+  // were one argument list): every compiler builds the same chain.
+  const Inertia base_inertia = randomInertia(rng);
+  const Vec3 base_axis = randomUnit(rng);
+  const SE3 base_placement = randomPlacement(rng);
+  b.addBody("base", -1, base_placement, JointType::Revolute, base_axis, base_inertia);
+  const Inertia plate_inertia = randomInertia(rng);
+  const SE3 plate_placement = randomPlacement(rng);
+  b.addBody("plate", 0, plate_placement, JointType::Fixed, Vec3::UnitZ(), plate_inertia);
+  const Inertia tool_inertia = randomInertia(rng);
+  const SE3 tool_placement = randomPlacement(rng);
+  b.addBody("tool", 1, tool_placement, JointType::Fixed, Vec3::UnitZ(), tool_inertia);
   System s;
   s.model = b.build();
   s.q = randomConfiguration(s.model, rng);
@@ -376,8 +389,11 @@ TEST(TreeSolver, LoopRowsBetweenBodiesAndOverJoints) {
             Ka.row(r) = randomRow(rng).transpose();
             Kb.row(r) = randomRow(rng).transpose();
           }
-          s.local.push_back(std::make_shared<LocalRows>("loop" + std::to_string(c), body(rng), Ka,
-                                                        body(rng), Kb));
+          // Body b drawn before body a: g++'s order when both were arguments.
+          const int body_b = body(rng);
+          const int body_a = body(rng);
+          s.local.push_back(
+              std::make_shared<LocalRows>("loop" + std::to_string(c), body_a, Ka, body_b, Kb));
         }
         MatX Aj(2, s.model.nv);
         for (int r = 0; r < 2; ++r) Aj.row(r) = randomVector(s.model.nv, rng).transpose();
@@ -418,7 +434,10 @@ TEST(TreeSolver, NearlyParallelLoopRowsNeedNoRefinement) {
         Kb.row(0) = randomRow(rng).transpose();
         Ka.row(1) = Ka.row(0) + delta * Ka.row(0).norm() * randomRow(rng).normalized().transpose();
         Kb.row(1) = Kb.row(0) + delta * Kb.row(0).norm() * randomRow(rng).normalized().transpose();
-        s.local.push_back(std::make_shared<LocalRows>("near", body(rng), Ka, body(rng), Kb));
+        // Body b drawn before body a: g++'s order when both were arguments.
+        const int body_b = body(rng);
+        const int body_a = body(rng);
+        s.local.push_back(std::make_shared<LocalRows>("near", body_a, Ka, body_b, Kb));
         MatX Aj(2, s.model.nv);
         for (int c = 0; c < s.model.nv; ++c) Aj(0, c) = g(rng), Aj(1, c) = g(rng);
         Aj.row(1) = Aj.row(0) + delta * Aj.row(0).norm() * Aj.row(1).normalized();
@@ -642,7 +661,10 @@ void addLoopRows(System& s, std::mt19937& rng, bool gear) {
   Rows Ka(1, 6), Kb(1, 6);
   Ka.row(0) = randomRow(rng).transpose();
   Kb.row(0) = randomRow(rng).transpose();
-  s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
+  // Body b drawn before body a: g++'s order when both were arguments.
+  const int body_b = body(rng);
+  const int body_a = body(rng);
+  s.local.push_back(std::make_shared<LocalRows>("loop", body_a, Ka, body_b, Kb));
   if (gear)
     s.joint.push_back(std::make_shared<JointRows>(
         "gear", MatX(randomVector(s.model.nv, rng).transpose())));

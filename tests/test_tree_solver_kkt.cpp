@@ -112,7 +112,10 @@ TEST(TreeSolver, MinimumNormLambdaWhenRedundancySpansBodies) {
           Rows Ka(1, 6), Kb(1, 6);
           Ka.row(0) = randomRow(rng).transpose();
           Kb.row(0) = randomRow(rng).transpose();
-          s.local.push_back(std::make_shared<LocalRows>("loop", body(rng), Ka, body(rng), Kb));
+          // Body b drawn before body a: g++'s order when both were arguments.
+          const int body_b = body(rng);
+          const int body_a = body(rng);
+          s.local.push_back(std::make_shared<LocalRows>("loop", body_a, Ka, body_b, Kb));
           addJointCopyOfLastRow(s, "joint_copy", 2.0);
         }
         makeConsistent(s, rng);

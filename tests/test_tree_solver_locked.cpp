@@ -30,7 +30,8 @@ int addJointLocks(System& s, std::mt19937& rng) {
     const int rows = u(rng) < 0.25 ? 2 : 1;
     for (int r = 0; r < rows; ++r) {
       MatX A(1, 1);
-      A(0, 0) = (u(rng) < 0.5 ? -1 : 1) * c(rng);
+      const double sign = u(rng) < 0.5 ? -1 : 1;  // drawn first, then the size
+      A(0, 0) = sign * c(rng);
       s.joint.push_back(std::make_shared<JointRows>(
           "lock" + std::to_string(r) + "@" + std::to_string(i), A, std::vector<int>{j.idx_v}));
       ++added;

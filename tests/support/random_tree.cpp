@@ -3,6 +3,31 @@
 
 namespace appell::test {
 
+namespace {
+
+// Several draws in one argument list happen in an order C++ leaves to the
+// compiler (g++ draws the last argument first, clang the first), so each
+// draw here is its own statement: every compiler builds the same inputs.
+// The order is the one g++ used before (the last component or argument
+// first), so the tests keep the inputs they were written against.
+template <class Distribution>
+Vec3 drawVec3(Distribution& d, std::mt19937& rng) {
+  const double z = d(rng);
+  const double y = d(rng);
+  const double x = d(rng);
+  return Vec3(x, y, z);
+}
+
+Mat3 randomRotation(std::normal_distribution<double>& g, std::mt19937& rng) {
+  const double c3 = g(rng);
+  const double c2 = g(rng);
+  const double c1 = g(rng);
+  const double c0 = g(rng);
+  return Quat(Eigen::Vector4d(c0, c1, c2, c3).normalized()).toRotationMatrix();
+}
+
+}  // namespace
+
 Inertia randomInertia(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0.2, 2.0), c(-0.3, 0.3);
   // Principal moments from a random box (always satisfies the triangle inequality).
@@ -11,22 +36,22 @@ Inertia randomInertia(std::mt19937& rng) {
   // From rng, not Quat::UnitRandom() (std::rand): a test's draws must not
   // depend on which tests ran before it in the same process.
   std::normal_distribution<double> g;
-  const Mat3 R = Quat(Eigen::Vector4d(g(rng), g(rng), g(rng), g(rng)).normalized()).toRotationMatrix();
-  return {m, Vec3(c(rng), c(rng), c(rng)), R * moments.asDiagonal() * R.transpose()};
+  const Mat3 R = randomRotation(g, rng);
+  return {m, drawVec3(c, rng), R * moments.asDiagonal() * R.transpose()};
 }
 
 SE3 randomPlacement(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   std::normal_distribution<double> g;
   SE3 X;
-  X.R = Quat(Eigen::Vector4d(g(rng), g(rng), g(rng), g(rng)).normalized()).toRotationMatrix();
-  X.p = Vec3(u(rng), u(rng), u(rng));
+  X.R = randomRotation(g, rng);
+  X.p = drawVec3(u, rng);
   return X;
 }
 
 Vec3 randomUnit(std::mt19937& rng) {
   std::normal_distribution<double> g;
-  return Vec3(g(rng), g(rng), g(rng)).normalized();
+  return drawVec3(g, rng).normalized();
 }
 
 Model randomTree(int n, bool floating_base, std::mt19937& rng) {
@@ -41,8 +66,11 @@ Model randomTree(int n, bool floating_base, std::mt19937& rng) {
       parent = std::uniform_int_distribution<int>(floating_base ? 0 : -1, i - 1)(rng);
       type = kinds[std::uniform_int_distribution<int>(0, 6)(rng)];
     }
-    b.addBody("body" + std::to_string(i), parent, randomPlacement(rng), type, randomUnit(rng),
-              randomInertia(rng));
+    // Last argument first: the order g++ evaluated the former one-line call in.
+    const Inertia inertia = randomInertia(rng);
+    const Vec3 axis = randomUnit(rng);
+    const SE3 placement = randomPlacement(rng);
+    b.addBody("body" + std::to_string(i), parent, placement, type, axis, inertia);
   }
   return b.build();
 }

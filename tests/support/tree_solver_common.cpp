@@ -85,7 +85,10 @@ void addRandomRows(System& s, std::mt19937& rng, const RowRecipe& recipe) {
         Vec6 w = randomRow(rng);
         const Mat6X& S = s.model.joints[i].S;
         if (!earlier.empty() && u(rng) < recipe.p_duplicate) {
-          w = sc(rng) * earlier[std::uniform_int_distribution<size_t>(0, earlier.size() - 1)(rng)];
+          // The row first, then the scale (g++'s order when both were
+          // operands of one product): every compiler draws the same rows.
+          const size_t which = std::uniform_int_distribution<size_t>(0, earlier.size() - 1)(rng);
+          w = sc(rng) * earlier[which];
           if (w.norm() == 0) w = randomRow(rng);
         } else if (S.cols() > 0 && S.cols() < 6 && u(rng) < recipe.p_immobile) {
           // w·S = 0: the body's own joint cannot move this row.

@@ -252,8 +252,14 @@ VecX randomConfiguration(const Model& model, std::mt19937& rng) {
   std::normal_distribution<double> gauss;
   VecX q = neutralConfiguration(model);
   auto randomQuat = [&](int at) {
-    Eigen::Vector4d g(gauss(rng), gauss(rng), gauss(rng), gauss(rng));  // uniform on S³
-    q.segment<4>(at) = g.normalized();
+    // Uniform on S³. One draw per statement, the last component first (the
+    // order g++ evaluated them in as constructor arguments, an order C++
+    // leaves to the compiler): every compiler draws the same configurations.
+    const double g3 = gauss(rng);
+    const double g2 = gauss(rng);
+    const double g1 = gauss(rng);
+    const double g0 = gauss(rng);
+    q.segment<4>(at) = Eigen::Vector4d(g0, g1, g2, g3).normalized();
   };
   for (const Joint& j : model.joints) {
     switch (j.type) {
