@@ -10,11 +10,12 @@
 // (De Saxcé & Feng, "New inequality and functional for contact with
 // friction", Mech. Struct. Mach. 19, 1991); equality rows u_e = 0 while the
 // block pushes (P_n > 0), P = 0 otherwise. Solved by non-smooth block
-// Gauss–Seidel (Jean 1999; Acary & Brogliato 2008 §13.7): each block exactly
-// given the others — sticking by one solve with W_bb's LDLᵀ when that impulse
-// lies in the cone, else its normal row and its friction disk alternated to
-// their fixed point (the disk's minimizer in W's metric, friction_onset.cpp,
-// from the block's eigen-decomposition), its equality rows by the LDLᵀ; both
+// Gauss–Seidel (Jean 1999; Acary & Brogliato 2008 §13.7): each block given
+// the others — sticking by one solve with W_bb's LDLᵀ when that impulse lies
+// in the cone, else its normal row, then its friction disk at that normal
+// impulse (the disk's minimizer in W's metric from the block's
+// eigen-decomposition, Newton on the secular equation), its equality rows
+// by the LDLᵀ; both
 // factors computed once per problem, not per sweep — until the natural-map
 // residual
 //     ‖P − Π_K(P − ρ ũ)‖ / ρ,   ρ = block size / trace(W_bb)
@@ -26,10 +27,13 @@
 // contacts into open, sticking and sliding (each sliding along −u_f), those
 // modes' equalities — u = target on a sticking contact's rows, u_n = target
 // and P_f = μ P_n d on a sliding one's — are one linear system A x = r in the
-// pushing contacts' unknowns. It is solved for the minimum-norm correction of
-// the Gauss–Seidel iterate (A Aᵀ y = r − A x, δ = Aᵀ y, by Cholesky with a
-// relative 1e-14 shift and refinement; the sliding directions updated from
-// the new u and solved again), and accepted only when the result is
+// pushing contacts' unknowns. It is solved for a correction of the
+// Gauss–Seidel iterate — with no sliding contact (A symmetric semidefinite)
+// by iterated Tikhonov regularization, δ ← δ + (A + εI)⁻¹(r − A δ), which
+// leaves A's null directions alone and does not square its condition; with
+// sliding ones by the shifted normal equations A Aᵀ y = r − A x, δ = Aᵀ y,
+// refined, the sliding directions updated from the new u and solved
+// again —, and accepted only when the result is
 // cone-feasible and every block's natural-map residual meets the tolerance —
 // the same test Gauss–Seidel stops on, so the answer's guarantee does not
 // change. (The polishing step of Stellato et al., "OSQP: an operator
@@ -90,7 +94,8 @@ struct ContactProblem {
   bool readModes();
   void activeSet();
   bool solveModes(double tol);
-  bool solveActiveSet();
+  bool solveActiveSet(double tol);
+  bool solveNormalEquations();
   bool adjustModes(double tol);
   void expand(const VecX& x);
   // Per block, fixed within a problem: the friction disk's factor and the
@@ -105,7 +110,8 @@ struct ContactProblem {
   std::vector<signed char> mode_;
   std::vector<Vec3> dir_;
   MatX A_, B_;
-  VecX x_, r_, y_, P_save_, u_save_;
+  VecX x_, r_, y_, P_save_, u_save_, delta_;
+  std::vector<int> piv_;
 };
 
 /// The candidates' rows as a dense J over v (O(rows · nv)), and the
