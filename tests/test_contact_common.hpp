@@ -5,6 +5,8 @@
 #include <appell/contact_geometry.hpp>
 #include <appell/contacts.hpp>
 
+#include "random_draws.hpp"
+
 #include <cmath>
 #include <functional>
 #include <random>
@@ -13,17 +15,7 @@
 
 namespace appell::testing {
 
-// Each draw is its own statement: in one argument list their order is left
-// to the compiler (g++ draws the last argument first, clang the first), and
-// every compiler must test the same poses. The order kept is g++'s (last
-// component first), the one the tests were written against.
-template <class Distribution>
-Vec3 drawVec3(Distribution& d, std::mt19937& rng) {
-  const double z = d(rng);
-  const double y = d(rng);
-  const double x = d(rng);
-  return Vec3(x, y, z);
-}
+using appell::test::drawVec3;  // (random_draws.hpp: one draw order for every compiler)
 inline Vec3 randomVec(std::mt19937& rng, double scale = 1.0) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   return scale * drawVec3(u, rng);

@@ -1,22 +1,10 @@
 // The functions declared in random_tree.hpp, compiled once (see there for what they build).
 #include "random_tree.hpp"
+#include "random_draws.hpp"
 
 namespace appell::test {
 
 namespace {
-
-// Several draws in one argument list happen in an order C++ leaves to the
-// compiler (g++ draws the last argument first, clang the first), so each
-// draw here is its own statement: every compiler builds the same inputs.
-// The order is the one g++ used before (the last component or argument
-// first), so the tests keep the inputs they were written against.
-template <class Distribution>
-Vec3 drawVec3(Distribution& d, std::mt19937& rng) {
-  const double z = d(rng);
-  const double y = d(rng);
-  const double x = d(rng);
-  return Vec3(x, y, z);
-}
 
 Mat3 randomRotation(std::normal_distribution<double>& g, std::mt19937& rng) {
   const double c3 = g(rng);

@@ -34,21 +34,28 @@ detail::DiskFactor detail::factorDisk(const Mat3& H, int n) {
   return f;
 }
 
-Vec3 detail::diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r) {
-  if (!(r > 0)) return Vec3::Zero();
+bool detail::diskUnconstrained(const DiskFactor& H, const Vec3& c, int n, Vec3& cq, Vec3& fq) {
   Vec3 cp = Vec3::Zero();
   cp.head(n) = c.head(n);
   const Vec3& lam = H.values;
-  const Vec3 cq = H.vectors.transpose() * cp;
+  cq = H.vectors.transpose() * cp;
   const double tiny = 1e-12 * std::max(lam.maxCoeff(), 1e-300);
   // The minimum-norm unconstrained minimizer exists when c has no part in
   // H's null space.
   bool bounded = true;
-  Vec3 fq = Vec3::Zero();
+  fq.setZero();
   for (int i = 0; i < 3; ++i) {
     if (lam[i] > tiny) fq[i] = -cq[i] / lam[i];
     else if (std::abs(cq[i]) > 1e-14 * (cq.norm() + 1e-300)) bounded = false;
   }
+  return bounded;
+}
+
+Vec3 detail::diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r) {
+  if (!(r > 0)) return Vec3::Zero();
+  Vec3 cq, fq;
+  const bool bounded = diskUnconstrained(H, c, n, cq, fq);
+  const Vec3& lam = H.values;
   if (bounded && fq.norm() <= r) {
     Vec3 f = H.vectors * fq;
     f.tail(3 - n).setZero();

@@ -86,5 +86,11 @@ struct DiskFactor {
 DiskFactor factorDisk(const Mat3& H, int n);
 /// diskMinimizer(H, c, n, r) from H's factor: the same arithmetic.
 Vec3 diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r);
+/// The disk problem without its disk, in H's eigenbasis: cq = Vᵀc (c past n
+/// zero) and fq the minimum-norm unconstrained minimizer (zero along H's
+/// null directions). false when c has a part in that null space: no finite
+/// minimizer, the answer is on the circle. Shared by diskMinimizer and the
+/// time-stepping solver's Newton version (timestepping/contact_problem.cpp).
+bool diskUnconstrained(const DiskFactor& H, const Vec3& c, int n, Vec3& cq, Vec3& fq);
 
 }  // namespace appell::detail

@@ -38,17 +38,9 @@ Vec3 projectOntoCone(double zn, const Vec3& zf, double mu, Vec3& out_f) {
 /// bisection of friction_problem.cpp takes ~55.
 Vec3 diskNewton(const detail::DiskFactor& H, const Vec3& c, int n, double r) {
   if (!(r > 0)) return Vec3::Zero();
-  Vec3 cp = Vec3::Zero();
-  cp.head(n) = c.head(n);
+  Vec3 cq, fq;
+  const bool bounded = detail::diskUnconstrained(H, c, n, cq, fq);
   const Vec3& lam = H.values;
-  const Vec3 cq = H.vectors.transpose() * cp;
-  const double tiny = 1e-12 * std::max(lam.maxCoeff(), 1e-300);
-  bool bounded = true;
-  Vec3 fq = Vec3::Zero();
-  for (int i = 0; i < 3; ++i) {
-    if (lam[i] > tiny) fq[i] = -cq[i] / lam[i];
-    else if (std::abs(cq[i]) > 1e-14 * (cq.norm() + 1e-300)) bounded = false;
-  }
   if (!(bounded && fq.norm() <= r)) {
     // ν* ≥ |cq_i|/r − λ_i for each i (one component alone reaches r).
     double nu = 0;
