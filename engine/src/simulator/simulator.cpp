@@ -46,11 +46,15 @@ Simulator::Impl::Impl(const Model& model, ConstraintList constraints,
   result_.reaction = VecX::Zero(model_.nv);
   setUpUnilateral();  // after q_, v_: its workspace copies their sizes
   timestepping::checkOptions(options_.timestepping);
-  // The time-stepping stage's workspace is dense over the unilateral rows
-  // (Delassus columns nv × rows): built here when that is modest, else when
-  // a first window needs it (timeSteppingStage) — a chain of 10⁵ joint
-  // limits must not reserve 10⁵ × 10⁵ doubles it never uses.
-  if (uni_ && static_cast<double>(model_.nv) * cdata_->m <= kEagerTimeSteppingDoubles)
+  // The time-stepping stage's workspace is dense over the unilateral rows —
+  // the Delassus maps (2 nv × rows) and the contact problem's three rows ×
+  // rows matrices (timestepping/delassus.cpp, contact_problem.cpp), m bounding
+  // rows: built here when that is modest, else when a first window needs it
+  // (timeSteppingStage) — a chain of 10⁵ joint limits must not reserve
+  // 10⁵ × 10⁵ doubles it never uses. (Counting nv × m alone, 740 balls on a
+  // floor reserved 0.30 GB here: docs/hardening.md.)
+  const double m = cdata_->m;
+  if (uni_ && 2.0 * model_.nv * m + 3.0 * m * m <= kEagerTimeSteppingDoubles)
     timeSteppingStage();
   last_modes_.assign(constraints_.size(), 0);
   event_ring_.assign(options_.timestepping.zeno_events, 0.0);
