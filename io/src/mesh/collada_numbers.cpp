@@ -53,6 +53,25 @@ void checkCountAttributes(const std::string& path, const std::string& text) {
   }
 }
 
+// An array holds the number of values its count declares. assimp 5.2.5
+// trusts the count: a <float_array count="0"> holding a triangle's nine
+// coordinates, read by an accessor of three points, was a null dereference
+// inside assimp (the mesh fuzzer, 2026-11-27:
+// tests/data/fuzz-regressions/mesh_dae_array_count_segv_refused.dae).
+void checkArrayCount(const std::string& path, const std::string& text, std::size_t at,
+                     std::size_t open_end, const std::string& name, std::size_t values) {
+  const std::string open = text.substr(at, open_end - at);
+  const std::size_t c = open.find("count=\"");
+  if (c == std::string::npos) return;  // (checkCountAttributes names it)
+  std::size_t declared = 0;
+  for (std::size_t k = c + 7; k < open.size() && std::isdigit(static_cast<unsigned char>(open[k])); ++k)
+    declared = declared * 10 + static_cast<std::size_t>(open[k] - '0');
+  if (declared != values)
+    throw SceneError(path + ":" + std::to_string(lineAt(text, at)) + ": <" + name + ">: count=\"" +
+                     std::to_string(declared) + "\" but it holds " + std::to_string(values) +
+                     " values: the file is damaged");
+}
+
 // The text of each list element: digits (and, for coordinates, a decimal
 // number's signs, point and exponent) and white space only.
 void checkNumberLists(const std::string& path, const std::string& text) {
@@ -75,7 +94,8 @@ void checkNumberLists(const std::string& path, const std::string& text) {
         throw SceneError(path + ":" + std::to_string(lineAt(text, k)) + ": <" + name + ">: " + why +
                          ": the file is damaged");
       };
-      std::size_t value = 0;
+      std::size_t value = 0, values = 0;
+      bool in_value = false;
       for (std::size_t k = open_end + 1; k < close; ++k) {
         const unsigned char c = static_cast<unsigned char>(text[k]);
         // The C locale's white space, tested inline: a published robot's
@@ -83,8 +103,11 @@ void checkNumberLists(const std::string& path, const std::string& text) {
         // character was a sixth of `appell info`'s time on ANYmal.
         if (c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\v' || c == '\f') {
           value = 0;
+          in_value = false;
           continue;
         }
+        values += in_value ? 0 : 1;
+        in_value = true;
         const bool digit = c >= '0' && c <= '9';
         const bool ok = digit || (!list.indices && (c == '.' || c == '-' || c == '+' || c == 'e' || c == 'E'));
         if (!ok) {
@@ -97,6 +120,7 @@ void checkNumberLists(const std::string& path, const std::string& text) {
           if (value > text.size()) bad(k, "an index or count larger than the file could hold values for");
         }
       }
+      if (name == "float_array" || name == "int_array") checkArrayCount(path, text, at, open_end, name, values);
       at = close;
     }
   }
