@@ -14,7 +14,7 @@
 # A run the stall watchdog stops (run/src/stall_watch.cpp: wall-clock time)
 # ends where the machine's load let it get. The automatic scheme's switch to
 # time-stepping no longer depends on the wall clock (docs/contacts.md §10:
-# it counts evaluations), so a run that finishes is reproducible bit for bit.
+# it counts the simulation's work), so a run that finishes is reproducible bit for bit.
 set -u
 abs() { [ "$1" = - ] && echo - || echo "$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"; }
 base=$(abs "$1")

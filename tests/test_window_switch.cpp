@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <appell/output.hpp>
+#include <appell/overrides.hpp>
 #include <appell/run.hpp>
 #include <appell/simulator.hpp>
 #include <appell/urdf.hpp>
@@ -128,9 +129,9 @@ TEST(WindowSwitch, CadCarHandBackAfterAWindowOpenedInTheStall) {
 // Protects the automatic scheme's stall rule: at the CAD car's steering
 // step (t = 2 s) every tyre slips, rear_right_tyre chatters and the event
 // steps collapse with no further event (no Zeno) — and the automatic scheme
-// opens a window there after stall_evaluations evaluations that advance less
-// than stall_time, whatever the machine's load: two runs of one binary write
-// the same CSV byte for byte.
+// opens a window there once stall_work units of work (solves and friction
+// block updates) advance less than stall_time, whatever the machine's load:
+// two runs of one binary write the same CSV byte for byte.
 TEST(WindowSwitch, StallRuleOpensAWindowDeterministically) {
   const Scene scene = loadScene(kCadCar);
   RunOptions o = runOptions(scene.settings);
@@ -154,6 +155,56 @@ TEST(WindowSwitch, StallRuleOpensAWindowDeterministically) {
   EXPECT_EQ(reason[0], reason[1]);
   EXPECT_GT(csv[0].size(), 1000u);
   EXPECT_TRUE(csv[0] == csv[1]) << "two runs of one binary differ";
+}
+
+// Protects the stall rule's measure of work on a stall that an evaluation
+// count missed: a car from a random sweep (examples/car, the rear-left tyre
+// driven at 6.7 N·m on μ 0.84, the others at their drawn μ), whose driven
+// tyre slides at a slip of at most 1.2e-7 m/s from t = 0 and whose event
+// steps collapse — dopri5 took 4 320 steps in 0.46 ms, 1.6·10⁸ solves per
+// simulated second, below the old rule's 5 000 evaluations per 10 µs, and the
+// wall-clock watchdog stopped it (exit 3). Under events it still stalls
+// (checked: over 500 steps in 0.1 ms); under auto the rule opens a window
+// within its work budget of the stall's start, and the run goes on with its
+// work balance closed.
+TEST(WindowSwitch, SweptCarWhoseSlipStallsSwitchesWithinItsWorkBudget) {
+  Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf");
+  OverrideReport report;
+  const std::pair<const char*, double> set[] = {
+      {"speed", 2.4985710961287424},           {"front_left_tyre.mu", 0.5553586752304251},
+      {"front_right_tyre.mu", 0.6390676315722099}, {"rear_left_tyre.mu", 0.8439139685945805},
+      {"rear_right_tyre.mu", 0.5938810795351981},  {"rear_left_joint.effort", 6.692642203185458},
+      {"rear_right_joint.effort", -0.7559314787229798}};
+  for (const auto& [name, value] : set) applyOverride(scene, name, {value}, report);
+  completeVelocities(scene, report);
+  RunOptions o = runOptions(scene.settings);
+  o.watchdog_fraction = 0;  // (the rule, not the wall clock)
+  o.contacts = ContactScheme::Events;
+  o.duration = 1e-4;
+  const RunSummary events = runScene(scene, o, RunObserver{});
+  ASSERT_TRUE(events.ok) << events.failure;
+  // (A car at 2.5 m/s takes one step of 1 ms there; this one takes ~900.)
+  EXPECT_GT(events.counters.steps, 500) << "the event steps collapse";
+  o.contacts = ContactScheme::Auto;
+  o.duration = 0.5;
+  std::string reason;
+  long work_at_switch = -1;
+  double t_switch = -1;
+  const RunSummary s = runScene(scene, o, RunObserver{}, [&](const Simulator& sim) {
+    if (sim.counters().windows == 1 && work_at_switch < 0) {
+      reason = sim.windowReason();
+      work_at_switch = sim.counters().solves + sim.counters().block_updates;
+      t_switch = sim.time();
+    }
+  });
+  ASSERT_TRUE(s.ok) << s.failure;
+  EXPECT_NEAR(s.time, 0.5, 1e-12);
+  EXPECT_EQ(reason.rfind("the steps stalled: ", 0), 0u) << reason;
+  const TimeSteppingOptions rule;
+  EXPECT_LE(work_at_switch, rule.stall_work + rule.stall_work / 2) << "the switch within its budget";
+  EXPECT_LT(t_switch, rule.stall_time);
+  EXPECT_LT(s.relativeEnergyDeviation(), 1e-6) << s.max_energy_deviation << " J";
+  EXPECT_GT(s.joint_work, 10.0) << "the driven tyre works on";
 }
 
 // Protects the stall watchdog of the run loop: a watchdog that demands more

@@ -8,7 +8,7 @@
 // contacts that changed mode in that stretch, the events per simulated
 // second and the last mode changes. It only stops runs: the automatic
 // scheme's switch to time-stepping is decided inside the simulator by
-// counts of evaluations (TimeSteppingOptions::stall_evaluations), so that a
+// counts of its own work (TimeSteppingOptions::stall_work), so that a
 // trajectory does not depend on the machine's load.
 #pragma once
 

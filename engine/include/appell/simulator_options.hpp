@@ -41,14 +41,15 @@ struct TimeSteppingOptions {
   // auto: when a window starts …
   int zeno_events = 64;      ///< … this many events within zeno_time (s) of simulated time
   double zeno_time = 1e-2;
-  /// … or when stall_evaluations dynamics evaluations of the event scheme
-  /// (every stage, rejected steps and event location included) advance the
-  /// simulated time by less than stall_time (s): a stall decided by counts
-  /// of the simulation's own work, so the same run switches at the same
-  /// state on any machine under any load (the wall clock only stops a run:
-  /// RunOptions::watchdog_fraction).
-  long stall_evaluations = 5000;
-  double stall_time = 1e-5;
+  /// … or when the last stall_work units of the event scheme's work
+  /// (SimulatorCounters::solves + block_updates: every stage, rejected steps
+  /// and event location included) advanced the simulated time by less than
+  /// stall_time (s): a stall decided by counts of the simulation's own work,
+  /// so the same run switches at the same state on any machine under any
+  /// load (the wall clock only stops a run: RunOptions::watchdog_fraction).
+  /// 10⁵ units are 0.3–1 s of CPU on a car (docs/contacts.md §10).
+  long stall_work = 100000;
+  double stall_time = 1e-3;
   // … and when it ends: at least min_window (s, doubled each time the events
   // fail again within a window's length of its end), the contact modes
   // unchanged over stable_steps steps, and the event scheme's modes decided.
@@ -89,7 +90,13 @@ struct StepStatus {
 struct SimulatorCounters {
   long steps = 0;                  ///< accepted steps
   long rejected = 0;               ///< rejected attempts (adaptive)
-  long evaluations = 0;            ///< dynamics solves by the integrator
+  long evaluations = 0;            ///< calls of the integrator's field (v̇ at a stage)
+  /// The constrained solver's dynamics solves and velocity projections (an
+  /// evaluation with k sliding contacts takes k + 2 of them), and the blocks
+  /// that the friction problems' Gauss–Seidel sweeps solved: the
+  /// simulation's work, which the automatic scheme's stall rule counts.
+  long solves = 0;
+  long block_updates = 0;
   long failed = 0;                 ///< step() calls that returned !ok
   long projection_iterations = 0;  ///< Newton iterations of the position projection
   long events = 0;                 ///< contact events (touchdown, bounce, lift-off)

@@ -216,8 +216,7 @@ bool Simulator::Impl::solveTrialSet(bool held, bool& consistent, std::string& er
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   if (held && cdata_->m_active > 0) {
     u.vplus = v_;
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus,
-                                  u.impulse)) {
+    if (!kernelProject(*cdata_, q_, u.vplus, u.impulse)) {
       error = "contact modes: the velocity projection failed: " + solver_->lastError();
       return false;
     }

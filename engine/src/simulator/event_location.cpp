@@ -235,7 +235,7 @@ bool Simulator::Impl::projectAfterModes(std::string& error) {
   if (options_.project_velocities && cdata_->m_active > 0) {
     if (!options_.project_positions)
       evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
+    if (!kernelProject(*cdata_, q_, v_, impulse_)) {
       error = "velocity projection failed: " + solver_->lastError();
       return false;
     }

@@ -102,7 +102,7 @@ bool Simulator::Impl::slidingLoadResponses(const VecX& q, const VecX& v, const V
   const int k = static_cast<int>(run.size());
   for (int j = 0; j < k; ++j) {
     u.tau_unit = tau + u.G.col(j);
-    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u.tau_unit, u.unit, SolveOutputs::All);
+    kernelSolve(q, v, u.tau_unit, u.unit, SolveOutputs::All);
     if (!u.unit.ok) {
       out.ok = false;
       out.error = u.unit.error;
@@ -157,14 +157,14 @@ bool Simulator::Impl::solveDynamics(double t, const VecX& q, const VecX& v, cons
   if (u && markSliding(v)) return solveSettling(t, q, v, tau, out, outputs);
   if (u) u->friction_power = 0;
   if (!u || u->sliding.empty()) {
-    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, outputs);
+    kernelSolve(q, v, tau, out, outputs);
     return out.ok;
   }
   const int k = static_cast<int>(u->sliding.size());
   for (int j : u->sliding)
     detail::slipDirection(*cdata_, u->rows[j], 10 * options_.contacts.speed_tol);
   // λₙ⁰: the solve at τ (the full result in out).
-  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, SolveOutputs::All);
+  kernelSolve(q, v, tau, out, SolveOutputs::All);
   if (!out.ok) return false;
   for (int i = 0; i < k; ++i) u->lam0[i] = out.lambda[u->rows[u->sliding[i]].global];
   // Island by island: their loads do not answer one another's friction.
@@ -173,7 +173,7 @@ bool Simulator::Impl::solveDynamics(double t, const VecX& q, const VecX& v, cons
     if (!slidingNormalLoads(q, v, tau, u->sliding_runs[i],
                             detail::runOf(u->sliding, u->sliding_runs, i), out))
       return false;
-  solver_->solve(model_, *data_, constraints_, *cdata_, q, v, u->tau_f, out, outputs);
+  kernelSolve(q, v, u->tau_f, out, outputs);
   if (!out.ok) return false;
   if (outputs != SolveOutputs::All) return true;
   // Report the friction force on the friction rows' multipliers: the force

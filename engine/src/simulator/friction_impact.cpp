@@ -102,7 +102,7 @@ int Simulator::Impl::frictionImpactIsland(std::span<const int> run, bool first,
   if (!frictionImpactMaps(run, F, error)) return -1;
   // Block Gauss–Seidel over the disks, the normal impulses updated: a
   // contact sticks inside its static disk, else slides on its kinetic one.
-  const bool settled = p.gaussSeidel(K, F, 10000, [&](int j) {
+  const bool settled = p.gaussSeidel(K, F, 10000, counters_.block_updates, [&](int j) {
     const UnilateralRow& r = u.rows[run[j]];
     const int o0 = r.first_force, n = r.nf;
     const double pn = std::max(0.0, p.loadAt(j, F));
@@ -176,7 +176,7 @@ bool Simulator::Impl::frictionImpactMaps(std::span<const int> run, int F, std::s
   evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
   shiftImpactTargets();
   u.vplus = v_;
-  if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
+  if (!kernelProject(*cdata_, q_, u.vplus, u.impulse)) {
     error = "impact with friction: the impulse solve failed: " + solver_->lastError();
     return false;
   }

@@ -106,7 +106,7 @@ bool Simulator::Impl::frictionOnsetIsland(std::span<const int> run, int forced,
     return false;
   }
   // Block Gauss–Seidel, the loads updated as it goes.
-  const bool settled = p.gaussSeidel(K, F, 10000, [&](int j) {
+  const bool settled = p.gaussSeidel(K, F, 10000, counters_.block_updates, [&](int j) {
     const UnilateralRow& r = u.rows[run[j]];
     const int o0 = r.first_force, n = r.nf;
     const double radius = r.mu * std::max(0.0, p.loadAt(j, F));

@@ -44,11 +44,13 @@ struct FrictionProblem {
   /// Block Gauss–Seidel from f = 0 over K contacts until f stops changing
   /// (to 1e-14 of the largest radius): block(j) sets contact j's forces in
   /// f (the loads read the others' as they are) and returns its disk's
-  /// radius. false when `sweeps` sweeps did not settle it.
+  /// radius. false when `sweeps` sweeps did not settle it. Each block solved
+  /// adds one to `updates` (SimulatorCounters::block_updates).
   template <class Block>
-  bool gaussSeidel(int K, int F, int sweeps, Block&& block) {
+  bool gaussSeidel(int K, int F, int sweeps, long& updates, Block&& block) {
     f.head(F).setZero();
     for (int sweep = 0; sweep < sweeps; ++sweep) {
+      updates += K;
       f_old.head(F) = f.head(F);
       double fmax = 0;
       for (int j = 0; j < K; ++j) fmax = std::max(fmax, block(j));

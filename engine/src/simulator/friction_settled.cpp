@@ -227,7 +227,7 @@ bool Simulator::Impl::settleIsland(double t, const VecX& q, const VecX& v, const
   // sweeps. A candidate slow to settle, or whose minimizer is inside its
   // circle, slides along its slip (its force then known, still affine in
   // its load).
-  out.ok = p.gaussSeidel(K, F, 1000, [&](int j) { return settleCandidate(run, j, F); });
+  out.ok = p.gaussSeidel(K, F, 1000, counters_.block_updates, [&](int j) { return settleCandidate(run, j, F); });
   if (!out.ok) return true;
   u.settle_tau.noalias() += p.U.leftCols(F) * p.f.head(F);
   for (int c = 0; c < F; ++c) power -= p.f[c] * p.U.col(c).dot(v);

@@ -94,7 +94,7 @@ bool Simulator::Impl::impactPivoting(std::string& error) {
     evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
     shiftImpactTargets();
     u.vplus = v_;
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, u.vplus, u.impulse)) {
+    if (!kernelProject(*cdata_, q_, u.vplus, u.impulse)) {
       // Restitution targets on redundant rows can contradict each other: a
       // ball resting on one slope of a valley that strikes the other with
       // e > 0 cannot both rebound there and keep rolling on the first (two

@@ -351,7 +351,7 @@ bool Simulator::Impl::projectDrift(StepStatus& st, bool rows_current, std::strin
   if (options_.project_velocities && cdata_->m_active > 0) {
     if (!options_.project_positions && !rows_current)
       evaluateConstraintRows(model_, *data_, constraints_, *cdata_, t_, q_, v_);
-    if (!solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_)) {
+    if (!kernelProject(*cdata_, q_, v_, impulse_)) {
       field_->noteFailure(t_, q_, v_);
       error = "velocity projection failed: " + solver_->lastError();
       return false;

@@ -161,6 +161,18 @@ struct Simulator::Impl {
   double rowAcceleration(int u) const;
   void logEvent(ContactEventKind kind, int u, double before, double after, double impulse);
 
+  // The constrained solver's two operations, counted in counters_.solves
+  // (the stall rule's measure of work, with the friction block updates).
+  void kernelSolve(const VecX& q, const VecX& v, const VecX& tau, ConstrainedResult& out,
+                   SolveOutputs outputs) {
+    ++counters_.solves;
+    solver_->solve(model_, *data_, constraints_, *cdata_, q, v, tau, out, outputs);
+  }
+  bool kernelProject(ConstraintData& cd, const VecX& q, VecX& v, VecX& impulse) {
+    ++counters_.solves;
+    return solver_->projectVelocity(model_, *data_, constraints_, cd, q, v, impulse);
+  }
+
   const Model& model_;
   ConstraintList constraints_;
   std::unique_ptr<ConstrainedSolver> solver_;
@@ -202,9 +214,12 @@ struct Simulator::Impl {
   std::vector<double> event_ring_;
   long event_count_ = 0;
   int last_event_contact_ = -1;  // the constraint of the last mode change (events)
-  // The stall watch's stretch: where it began (time, evaluations so far).
-  double stall_t0_ = 0;
-  long stall_evaluations0_ = 0;
+  // The stall watch: the simulated time at the last kStallMarks marks, the
+  // marks so far, and the work at which the next is set.
+  static constexpr int kStallMarks = 4;
+  long work() const { return counters_.solves + counters_.block_updates; }
+  std::array<double, kStallMarks> stall_t_{};
+  long stall_marks_ = 0, stall_next_ = 0;
   std::string window_reason_;
 };
 
@@ -265,7 +280,7 @@ class Simulator::Impl::Field final : public AccelerationField {
   bool projectVelocity(double t, const VecX& q, VecX& v) override {
     Impl& s = s_;
     evaluateConstraintRows(s.model_, *s.data_, s.constraints_, *s.cdata_, t, q, v);
-    if (!s.solver_->projectVelocity(s.model_, *s.data_, s.constraints_, *s.cdata_, q, v, impulse_)) {
+    if (!s.kernelProject(*s.cdata_, q, v, impulse_)) {
       record("the leapfrog's velocity projection failed: " + s.solver_->lastError(), t);
       return false;
     }
@@ -297,7 +312,7 @@ class Simulator::Impl::Field final : public AccelerationField {
     velocityResiduals(*s.data_, s.constraints_, cd, w, residual_);
     residual_c_ -= residual_;
     shiftRowOffsets(s.constraints_, cd, residual_c_);
-    if (!s.solver_->projectVelocity(s.model_, *s.data_, s.constraints_, cd, q, w, impulse_)) {
+    if (!s.kernelProject(cd, q, w, impulse_)) {
       record("the leapfrog's constrained half-kick failed: " + s.solver_->lastError(), t);
       return false;
     }

@@ -5,10 +5,11 @@
 //   opens   when an event step fails (no consistent contact mode, a step
 //           below h_min, a solve that fails at a mode's state), when
 //           zeno_events events fall within zeno_time of simulated time
-//           (Zeno, slip ↔ stick chattering), when stall_evaluations dynamics
-//           evaluations advance the simulated time by less than stall_time
-//           (steps collapsing without events: a stall, decided by counts, so
-//           the switch does not depend on the machine's load), or when the
+//           (Zeno, slip ↔ stick chattering), when the last stall_work units
+//           of the simulation's work (solves and friction block updates)
+//           advanced the simulated time by less than stall_time (steps
+//           collapsing without events: a stall, decided by counts, so the
+//           switch does not depend on the machine's load), or when the
 //           caller asks (openTimeSteppingWindow);
 //   closes  after at least its minimum length, once the contact modes have
 //           not changed over stable_steps steps and the event scheme decides
@@ -76,9 +77,9 @@ void timestepping::checkOptions(const TimeSteppingOptions& o) {
   if (!(o.theta > 0 && o.theta <= 1))
     throw std::invalid_argument("Simulator: timestepping.theta must be in (0, 1], got " +
                                 std::to_string(o.theta));
-  if (o.max_sweeps < 1 || o.zeno_events < 2 || o.stall_evaluations < 1 || o.stable_steps < 1)
+  if (o.max_sweeps < 1 || o.zeno_events < 2 || o.stall_work < 4 /* its marks */ || o.stable_steps < 1)
     throw std::invalid_argument(
-        "Simulator: timestepping.max_sweeps ≥ 1, zeno_events ≥ 2, stall_evaluations ≥ 1 and "
+        "Simulator: timestepping.max_sweeps ≥ 1, zeno_events ≥ 2, stall_work ≥ 4 and "
         "stable_steps ≥ 1 are required");
 }
 
@@ -175,8 +176,9 @@ bool Simulator::Impl::closeWindow() {
 
 void Simulator::Impl::restartStallWatch() {
   event_count_ = 0;
-  stall_t0_ = t_;
-  stall_evaluations0_ = counters_.evaluations;
+  stall_marks_ = 0;
+  stall_next_ = work() + options_.timestepping.stall_work / kStallMarks;
+  stall_t_.fill(t_);
 }
 
 // The Zeno and stall watches of the automatic scheme, after an event step.
@@ -202,27 +204,24 @@ void Simulator::Impl::watchEvents() {
       return;
     }
   }
-  // The stall watch, over stretches of stall_evaluations evaluations: a
-  // stretch that advanced less than stall_time is a stall. Counted in
-  // evaluations, not steps: a run of tiny steps at a slip onset (legitimate
-  // at tight tolerances, ContactFriction.PushedBallSlipsWhenTheDemandReachesMu)
-  // is a few hundred steps, a stall tens of thousands of solves.
-  const long evaluations = counters_.evaluations - stall_evaluations0_;
-  if (evaluations < o.stall_evaluations) return;
-  const double advanced = t_ - stall_t0_;
-  if (advanced < o.stall_time) {
-    const int contact = last_event_contact_ >= 0 ? last_event_contact_ : namedContact("");
-    std::ostringstream why;
-    why << "the steps stalled: " << evaluations << " dynamics evaluations advanced " << advanced
-        << " s of simulated time (less than " << o.stall_time << " s; last mode change: '"
-        << constraints_[contact]->name() << "')";
-    if (timeSteppingStage()) {
-      openWindow(contact, why.str());
-      return;
-    }
-  }
-  stall_t0_ = t_;
-  stall_evaluations0_ = counters_.evaluations;
+  // The stall watch: a mark every stall_work / kStallMarks units of work,
+  // and the simulated time at the last kStallMarks marks. A stall is the
+  // last stall_work units (the work since the oldest mark) advancing less
+  // than stall_time; measured over that much work, a hard friction problem
+  // at one step (an onset's Gauss–Seidel taking 10⁴ block updates) is not
+  // one. Work, not evaluations: an evaluation with four sliding tyres costs
+  // a hundred times one with none (docs/contacts.md §10).
+  if (work() < stall_next_) return;
+  stall_next_ = work() + o.stall_work / kStallMarks;
+  const double oldest = stall_t_[stall_marks_ % kStallMarks];
+  stall_t_[stall_marks_++ % kStallMarks] = t_;
+  if (stall_marks_ < kStallMarks || t_ - oldest >= o.stall_time) return;
+  const int contact = last_event_contact_ >= 0 ? last_event_contact_ : namedContact("");
+  std::ostringstream why;
+  why << "the steps stalled: " << o.stall_work << " units of work (solves and friction block "
+      << "updates) advanced " << t_ - oldest << " s of simulated time (less than " << o.stall_time
+      << " s; last mode change: '" << constraints_[contact]->name() << "')";
+  if (timeSteppingStage()) openWindow(contact, why.str());
 }
 
 // The step's counters and its work terms (timestepping::StepWork) into the
@@ -291,7 +290,7 @@ StepStatus Simulator::Impl::timeSteppingStep(double h) {
     if (!projection_.ok) return fail(st, "position projection failed: " + projection_.error);
   }
   if (options_.project_velocities && cdata_->m_active > 0 &&
-      !solver_->projectVelocity(model_, *data_, constraints_, *cdata_, q_, v_, impulse_))
+      !kernelProject(*cdata_, q_, v_, impulse_))
     return fail(st, "velocity projection failed: " + solver_->lastError());
   // The residuals the run watches as drift: of the rows this step holds
   // exactly, the bilateral ones just projected. A closed contact holds only

@@ -99,14 +99,12 @@ struct RunOptions {
   /// does not, the run stops as failed, naming the contacts, the events per
   /// simulated second and the last mode changes. It never switches the
   /// scheme: a trajectory must not depend on the machine's load — the
-  /// automatic scheme's own stall rule (TimeSteppingOptions::
-  /// stall_evaluations) switches by counts. 0 switches it off.
-  /// The interval is 20 s so that the automatic scheme's stall rule acts
-  /// first: at the CAD car's stall (examples/cad_car, t = 2.0015 s) its
-  /// 5 000 evaluations of four sliding tyres took 5–10 s of CPU, and a 5 s
-  /// interval stopped that default run (3 of 3, quiet machine, 2026-11-27).
+  /// automatic scheme's own stall rule (TimeSteppingOptions::stall_work)
+  /// switches by counts, and must act first: its 10⁵ units of work take
+  /// 0.2–0.8 s of CPU at the stalls measured (docs/contacts.md §10), well
+  /// inside the 5 s interval. 0 switches it off.
   double watchdog_fraction = 1e-3;
-  double watchdog_interval = 20.0;
+  double watchdog_interval = 5.0;
 };
 
 /// The scene's own settings as run options. Throws std::invalid_argument for
