@@ -50,6 +50,7 @@ struct Candidate {
   int f[3] = {-1, -1, -1};
   int e[6] = {-1, -1, -1, -1, -1, -1};
   double mu = 0, restitution = 0;
+  double mu_kinetic = 0;  ///< the cone's μ for a contact that slid at the last step
   int rows() const { return 1 + nf + ne; }
 };
 
@@ -108,6 +109,8 @@ class MoreauJean {
   std::vector<int> first_;         ///< per all_: first local row (−1: not a candidate)
   std::vector<Mode> modes_;
   std::vector<char> rebound_;
+  std::vector<char> slid_;         ///< per all_: sliding at the step's start (μₖ)
+  std::vector<char> restituted_;   ///< per all_: its normal target is Newton's restitution
   std::vector<double> warm_;       ///< per all_ (6 each): the last step's impulses
   std::vector<int> map_;           ///< per problem row: its row in the Delassus J
   int rows_ = 0;                   ///< rows of every candidate (J's layout)
