@@ -102,13 +102,18 @@ std::vector<Node> readNodes(const std::string& path, const std::string& text) {
 // Expanded sizes of every node reachable from the visual scenes, post-order
 // with an explicit stack; a node met again while it is open is a cycle.
 void boundExpansion(const std::string& path, const std::string& text, const std::vector<Node>& nodes) {
-  std::unordered_map<std::string, int> by_id;
+  // An id should name one element, but a damaged file may give two nodes
+  // one id, and which of them an importer resolves is its own choice: an
+  // instance leads to every node of that id (a fuzzed file whose second
+  // "n2" closed a cycle that the first did not overflowed assimp's stack).
+  std::unordered_map<std::string, std::vector<int>> by_id;
   for (int k = 0; k < static_cast<int>(nodes.size()); ++k)
-    if (!nodes[k].id.empty()) by_id.emplace(nodes[k].id, k);
+    if (!nodes[k].id.empty()) by_id[nodes[k].id].push_back(k);
   auto edges = [&](int k) {
     std::vector<int> out = nodes[k].children;
     for (const std::string& target : nodes[k].instances)
-      if (auto it = by_id.find(target); it != by_id.end()) out.push_back(it->second);
+      if (auto it = by_id.find(target); it != by_id.end())
+        out.insert(out.end(), it->second.begin(), it->second.end());
     return out;
   };
   enum State : char { Unseen, Open, Done };
