@@ -104,6 +104,40 @@ TEST(ContactTimeStepping, BoxPushedToSlidingOnFourCorners) {
   EXPECT_LT(errors[1], 0.7 * errors[0]) << "first order: the error shrinks with h";
 }
 
+// Protects Coulomb's two coefficients in the time-stepping step: the box on
+// four corners pushed by F = k t sticks on the static cone until F = μₛ m g,
+// t* = μₛ m g / k, then slides against the kinetic force μₖ m g:
+// v(t) = (k (t² − t*²)/2 − μₖ m g (t − t*)) / m. Before 2026-11-27 every
+// step solved the static cone, and a sliding contact pushed out of an
+// O(h) overlap was taken for a rebound (reported open): the box slid
+// against μₛ m g, 0.73 m/s slower at 0.7 s.
+TEST(ContactTimeStepping, BoxSticksOnTheStaticConeAndSlidesOnTheKinetic) {
+  const double mu_s = 0.5, mu_k = 0.3, k = 30.0, T = 0.7, h = 1e-3;
+  const double t_star = mu_s * kMass * kG / k;
+  BoxScene s = cornerBox({.half = kHalf, .mass = kMass, .mu = mu_s, .mu_kinetic = mu_k});
+  SimulatorOptions so = scheme(ContactScheme::TimeStepping, h);
+  so.timestepping.residual_tol = 1e-8;
+  so.timestepping.max_sweeps = 500;
+  Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
+                IntegratorType::RK4, {}, so);
+  sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
+    tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
+  });
+  ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+  double t_slip = -1;
+  while (sim.time() < T - 1e-12) {
+    const StepStatus st = sim.step(std::min(h, T - sim.time()));
+    ASSERT_TRUE(st.ok) << st.message;
+    if (t_slip < 0 && worldLinear(sim).x() > 1e-6) t_slip = sim.time();
+  }
+  EXPECT_NEAR(t_slip, t_star, 2 * h + 1e-12) << "slip starts where F reaches μₛ m g";
+  const double v = (k * (T * T - t_star * t_star) / 2 - mu_k * kMass * kG * (T - t_star)) / kMass;
+  EXPECT_NEAR(worldLinear(sim).x(), v, 10 * h * k / kMass * (T - t_star)) << "slides against μₖ m g";
+  int sliding = 0;
+  for (int c = 0; c < 8; ++c) sliding += sim.isClosed(c) && sim.constraintData().isSliding(c);
+  EXPECT_EQ(sliding, 4) << "the four bottom corners closed and sliding";
+}
+
 // Protects the time-stepping balances: a frictionless box thrown sideways
 // and spinning onto the floor keeps its horizontal momentum to O(h) (every
 // impulse is vertical; the explicit step of a spinning body's body-frame
