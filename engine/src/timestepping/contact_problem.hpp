@@ -91,9 +91,10 @@ struct ContactProblem {
   void sweep();
   double maxResidual() const;
   bool polish(double tol);
+  bool polishFrom(double tol, bool from_zero);
   bool readModes();
   void activeSet();
-  bool solveModes(double tol);
+  bool solveModes(double tol, bool from_zero);
   bool solveActiveSet(double tol);
   bool solveNormalEquations();
   bool adjustModes(double tol);
