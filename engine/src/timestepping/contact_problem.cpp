@@ -216,6 +216,7 @@ void ContactProblem::solve(double tol, int max_sweeps) {
   residual = 0;
   converged = true;
   polished = false;
+  min_norm_failed_ = false;
   if (n == 0) return;
   factorBlocks();
   const double scale = std::max(1.0, u_free.head(n).lpNorm<Eigen::Infinity>());
@@ -420,9 +421,15 @@ bool ContactProblem::solveNormalEquations() {
 // 125/151/129/155 N (the events' split) to 217/60/42/241 N in 6 s and its
 // turn from 1.005 to 0.85 rad/s. Where the minimum-norm solve does not meet
 // the tolerance (ill-conditioned sticking: the CAD car's W spans 3.5 …
-// 1.7e-10), the correction nearest the iterate is tried next.
+// 1.7e-10), the correction nearest the iterate is tried next, and for the
+// rest of this step's sweeps alone (trying both at every finish doubled
+// cad_car's cost for the same trajectory).
 bool ContactProblem::polish(double tol) {
-  return polishFrom(tol, true) || polishFrom(tol, false);
+  if (!min_norm_failed_) {
+    if (polishFrom(tol, true)) return true;
+    min_norm_failed_ = true;  // (not tried again in this problem: half the finish's cost)
+  }
+  return polishFrom(tol, false);
 }
 
 bool ContactProblem::polishFrom(double tol, bool from_zero) {

@@ -92,6 +92,7 @@ struct ContactProblem {
   double maxResidual() const;
   bool polish(double tol);
   bool polishFrom(double tol, bool from_zero);
+  bool min_norm_failed_ = false;  // this solve's minimum-norm finish missed the tolerance
   bool readModes();
   void activeSet();
   bool solveModes(double tol, bool from_zero);
