@@ -335,3 +335,37 @@ TEST(ContactTimeStepping, SkidSteerTurnsAtTheEventsRate) {
   EXPECT_NEAR(yaw[1][1], yaw[0][1], 2e-3 * yaw[0][1]) << "time-stepping turns as the events do";
   EXPECT_NEAR(yaw[1][1], yaw[1][0], 1e-3) << "and steadily";
 }
+
+// Protects the automatic scheme on the box on four corners pushed to
+// sliding: the events are exact while it sticks, their steps collapse at the
+// slip onset of four redundant corners (no mode decision fails there, no
+// event piles up), and the stall rule opens one time-stepping window at the
+// onset; after it the events slide the box on to the closed form
+// v(t) = k (t − t*)²/(2m). The events alone take 12 000 – 22 000 steps for
+// 0.7 s (docs/contacts.md §8, known limit (2)); auto ~1 700 (the issue asks
+// ≤ 1 000: the stall's ~1 650 steps before the rule fires are the rest).
+TEST(ContactTimeStepping, BoxPushedUnderAutoTakesOneWindowAtItsOnset) {
+  const double mu = 0.5, k = 30.0, T = 0.7, t_star = mu * kMass * kG / k;
+  BoxScene s = box(0, ContactKind::Rolling, mu);
+  Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
+                IntegratorType::DormandPrince54, {}, scheme(ContactScheme::Auto));
+  sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
+    tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
+  });
+  ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
+  double h = 1e-3, t_window = -1;
+  while (sim.time() < T - 1e-12) {
+    const StepStatus st = sim.step(std::min(h, T - sim.time()));
+    ASSERT_TRUE(st.ok) << st.message;
+    h = st.h_next > 0 ? st.h_next : h;
+    if (t_window < 0 && sim.counters().windows > 0) t_window = sim.time();
+  }
+  std::cout << sim.counters().steps << " steps (" << sim.counters().rejected << " rejected), "
+            << sim.counters().timestepping_steps << " time-stepped, window at t = " << t_window << "\n";
+  EXPECT_EQ(sim.counters().windows, 1);
+  EXPECT_EQ(sim.windowReason().rfind("the steps stalled: ", 0), 0u) << sim.windowReason();
+  EXPECT_NEAR(t_window, t_star, 2e-3) << "at the slip onset";
+  const double v = k * (T - t_star) * (T - t_star) / (2 * kMass);
+  EXPECT_NEAR(worldLinear(sim).x(), v, 1e-3 * v) << "the window's O(h) error only";
+  EXPECT_LT(sim.counters().steps, 2500) << "the events alone: 12 000 – 22 000";
+}
