@@ -165,7 +165,8 @@ TEST(WindowSwitch, StallRuleOpensAWindowDeterministically) {
 // simulated second, below the old rule's 5 000 evaluations per 10 µs, and the
 // wall-clock watchdog stopped it (exit 3). Under events it still stalls
 // (checked: over 500 steps in 0.1 ms); under auto the rule opens a window
-// within its work budget of the stall's start, and the run goes on with its
+// within its work budget of the stall's start (low progress sustained over
+// 2.75 × 10⁵ units of work), and the run goes on with its
 // work balance closed.
 TEST(WindowSwitch, SweptCarWhoseSlipStallsSwitchesWithinItsWorkBudget) {
   Scene scene = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/car/car.urdf");
@@ -201,7 +202,9 @@ TEST(WindowSwitch, SweptCarWhoseSlipStallsSwitchesWithinItsWorkBudget) {
   EXPECT_NEAR(s.time, 0.5, 1e-12);
   EXPECT_EQ(reason.rfind("the steps stalled: ", 0), 0u) << reason;
   const TimeSteppingOptions rule;
-  EXPECT_LE(work_at_switch, rule.stall_work + rule.stall_work / 2) << "the switch within its budget";
+  // (Low progress over stall_work at 8 marks a quarter of it apart, from
+  // the first full stretch: 2.75 stall_work, plus a step's overshoot.)
+  EXPECT_LE(work_at_switch, 3 * rule.stall_work) << "the switch within its budget";
   EXPECT_LT(t_switch, rule.stall_time);
   EXPECT_LT(s.relativeEnergyDeviation(), 1e-6) << s.max_energy_deviation << " J";
   EXPECT_GT(s.joint_work, 10.0) << "the driven tyre works on";

@@ -44,10 +44,11 @@ struct TimeSteppingOptions {
   /// … or when the last stall_work units of the event scheme's work
   /// (SimulatorCounters::solves + block_updates: every stage, rejected steps
   /// and event location included) advanced the simulated time by less than
-  /// stall_time (s): a stall decided by counts of the simulation's own work,
+  /// stall_time (s), checked every stall_work/4 units and found at eight
+  /// checks in a row: a stall decided by counts of the simulation's own work,
   /// so the same run switches at the same state on any machine under any
   /// load (the wall clock only stops a run: RunOptions::watchdog_fraction).
-  /// 10⁵ units are 0.3–1 s of CPU on a car (docs/contacts.md §10).
+  /// 10⁵ units are 0.4–0.8 s of CPU on a car (docs/contacts.md §10).
   long stall_work = 100000;
   double stall_time = 1e-3;
   // … and when it ends: at least min_window (s, doubled each time the events

@@ -215,11 +215,12 @@ struct Simulator::Impl {
   long event_count_ = 0;
   int last_event_contact_ = -1;  // the constraint of the last mode change (events)
   // The stall watch: the simulated time at the last kStallMarks marks, the
-  // marks so far, and the work at which the next is set.
-  static constexpr int kStallMarks = 4;
+  // marks so far, the work at which the next is set, and the marks in a row
+  // that found low progress.
+  static constexpr int kStallMarks = 4, kStallLowMarks = 8;
   long work() const { return counters_.solves + counters_.block_updates; }
   std::array<double, kStallMarks> stall_t_{};
-  long stall_marks_ = 0, stall_next_ = 0;
+  long stall_marks_ = 0, stall_next_ = 0, stall_low_ = 0;
   std::string window_reason_;
 };
 

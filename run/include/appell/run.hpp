@@ -100,9 +100,9 @@ struct RunOptions {
   /// simulated second and the last mode changes. It never switches the
   /// scheme: a trajectory must not depend on the machine's load — the
   /// automatic scheme's own stall rule (TimeSteppingOptions::stall_work)
-  /// switches by counts, and must act first: its 10⁵ units of work take
-  /// 0.2–0.8 s of CPU at the stalls measured (docs/contacts.md §10), well
-  /// inside the 5 s interval. 0 switches it off.
+  /// switches by counts, and must act first: its 2.75·10⁵ units of work
+  /// take 1–2 s of CPU at the stalls measured (docs/contacts.md §10), inside
+  /// the 5 s interval. 0 switches it off.
   double watchdog_fraction = 1e-3;
   double watchdog_interval = 5.0;
 };
