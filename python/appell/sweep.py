@@ -213,9 +213,9 @@ def sweep(scene, parameters=None, *, samples=None, seed=None, cases=None, analys
     workers     threads or processes (default: the cores; a Client's own
                 worker threads)
     batch_size  cases per batch (default: ``_batch_count``'s rule — from
-                the first case's wall time, batches of at least a few ms
-                on threads, 20 ms on processes and 50 ms on Dask, up to
-                four per worker)
+                the first case's wall time, batches of at least 5 ms on
+                threads, 20 ms on processes and 50 ms on Dask, up to four
+                per worker; docs/python.md)
     """
     if analysis not in ("run", "linearize"):
         raise ValueError(f"analysis must be 'run' or 'linearize', not {analysis!r}")

@@ -14,9 +14,11 @@ scheduling, gathering, idling at the end), and CPU/wall, the cores this
 process used (serial and threads; 2 threads on 2 free cores give about 2 —
 less says the machine did not give them; processes and Dask work in other
 processes, so theirs is the parent's small share). The process pool and the
-cluster start once (their start-up printed apart) and run a two-case
-warm-up that loads the scene in each worker, as a user running many sweeps
-keeps them. Each sweep is checked equal to
+cluster start once (their start-up printed apart) and run a warm-up of
+one-case batches that loads the scene in each worker, as a user running many sweeps
+keeps them; "dask-cold" (not run unless named in --executors) is
+executor="dask", a LocalCluster started and closed by each sweep, its
+start-up and teardown inside the time. Each sweep is checked equal to
 the serial one bit for bit. Not a test: the figures depend on the machine
 and its load, so the load average is printed before and after each
 workload (python/bench/results.md records runs with it).
@@ -62,8 +64,11 @@ def same(a, b):
 
 def measure(work, executor, workers, repeat, reference):
     walls, overheads = [], []
-    appell.sweep(**dict(work, parameters={k: v[: 4 * workers] for k, v in work["parameters"].items()}),
-                 executor=executor, workers=workers)  # warm-up: the workers load the scene
+    # Warm-up: batches of one case, so that every worker loads the scene
+    # (not for "dask": its cluster is started and closed by each sweep).
+    if executor != "dask":
+            appell.sweep(**dict(work, parameters={k: v[: 4 * workers] for k, v in work["parameters"].items()}),
+                     executor=executor, workers=workers, batch_size=1)
     cpus = []
     for _ in range(repeat):
         start, cpu = time.perf_counter(), os.times()
@@ -119,7 +124,7 @@ def main():
     print(f"load average before: {os.getloadavg()}")
     # Pools and the cluster start once, as a user running many sweeps keeps
     # them; their start-up is reported apart.
-    pools = {"serial": "serial", "threads": "threads"}
+    pools = {"serial": "serial", "threads": "threads", "dask-cold": "dask"}
     names = args.executors.split(",")
     with contextlib.ExitStack() as stack:
         if "processes" in names:

@@ -144,9 +144,10 @@ py::dict runColumns(const std::vector<RunRow>& rows, const Scene& base) {
   d["max_gap_residual"] = numbers(rows, [](const RunRow& r) { return r.max_gap_residual; });
   d["steps"] = counts(rows, [](const RunRow& r) { return r.steps; });
   d["events"] = counts(rows, [](const RunRow& r) { return r.events; });
-  std::map<std::string, int> kinds;  // by name, as RunResult.event_counts lists them
-  for (const auto& k : contactEventKindTable()) kinds[k.name] = 0;
-  for (const auto& [name, unused] : kinds)
+  std::vector<std::string> kinds;  // by name, as RunResult.event_counts lists them
+  for (const auto& k : contactEventKindTable()) kinds.emplace_back(k.name);
+  std::sort(kinds.begin(), kinds.end());
+  for (const std::string& name : kinds)
     d[py::str("events_" + name)] = counts(rows, [&](const RunRow& r) {
       const auto it = r.event_counts.find(name);
       return it == r.event_counts.end() ? 0L : it->second;
