@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import numbers
 import os
 import time
 
@@ -238,14 +239,14 @@ def sweep(scene, parameters=None, *, samples=None, seed=None, cases=None, analys
     if remote and isinstance(scene, _appell.Scene):
         raise ValueError("processes and Dask workers load the scene themselves: give its path "
                          "(and load_options), not a loaded Scene")
-    if batch_size is not None and not (isinstance(batch_size, int) and batch_size >= 1):
+    if batch_size is not None and not (isinstance(batch_size, numbers.Integral) and batch_size >= 1):
         raise ValueError(f"batch_size must be a whole number ≥ 1, not {batch_size!r}")
     local = _scene_of(scene, load_options)  # the names' check; the pilot case of remote executors
     if not remote:
         scene = local
     _check_names(local, cases)
     start = time.perf_counter()
-    columns, label = _execute(Sweep(scene, local, load_options, analysis, options, cases), executor, workers,
+    columns, label = _execute(_SweepPlan(scene, local, load_options, analysis, options, cases), executor, workers,
                               batch_size)
     return SweepResult(names, cases, columns, label, time.perf_counter() - start)
 
@@ -288,7 +289,7 @@ def _slices(n, count):
     return [slice(bounds[i], bounds[i + 1]) for i in range(count)]
 
 
-class Sweep:
+class _SweepPlan:
     """What every batch shares: the scene (a path for remote workers), the
     one loaded here, its load options, the analysis and its options, the
     cases."""

@@ -25,7 +25,8 @@ workload (python/bench/results.md records runs with it).
 
     PYTHONPATH=build/python /usr/bin/python3 python/bench/sweep_scaling.py
 
-(--workloads disk-runs,bicycle picks some; --cases, --repeat, --workers.)
+(--workloads disk-runs,bicycle picks some; --cases, --repeat, --workers,
+--batch-size; --executors serial,threads,processes,dask,dask-cold.)
 """
 
 import argparse
@@ -62,7 +63,7 @@ def same(a, b):
     return all(np.array_equal(a[k], b[k], equal_nan=True) for k in keys if k in a)
 
 
-def measure(work, executor, workers, repeat, reference):
+def measure(work, executor, workers, repeat, reference, batch_size=None):
     walls, overheads = [], []
     # Warm-up: batches of one case, so that every worker loads the scene
     # (not for "dask": its cluster is started and closed by each sweep).
@@ -72,7 +73,7 @@ def measure(work, executor, workers, repeat, reference):
     cpus = []
     for _ in range(repeat):
         start, cpu = time.perf_counter(), os.times()
-        r = appell.sweep(executor=executor, workers=workers, **work)
+        r = appell.sweep(executor=executor, workers=workers, batch_size=batch_size, **work)
         wall = time.perf_counter() - start
         used = os.times()
         cpus.append((used.user + used.system - cpu.user - cpu.system) / wall)
@@ -86,29 +87,42 @@ def measure(work, executor, workers, repeat, reference):
 
 def cli_sweep(appell_cli, work, workers, repeat):
     """The same workload through `appell sweep` on 1 and on `workers` threads;
-    the tables checked byte for byte equal (--no-timing)."""
+    the tables checked byte for byte equal (--no-timing). Also a sweep of
+    its first case alone: the command's fixed cost (the process's start —
+    mostly the dynamic loader's relocations —, the scene's loading, the
+    table's writing), which no thread shares; the cases' own speed-up is
+    that of the walls less it."""
     import subprocess
 
     (name, values), = work["parameters"].items()
-    command = [appell_cli, "sweep", str(work["scene"]), "--no-timing",
-               "--vary", f"{name}={float(values[0])!r}:{float(values[-1])!r}:{len(values)}"]
-    if work.get("analysis") == "linearize":
-        command += ["--analysis", "linearize", "--cyclic", ",".join(work["cyclic"])]
-    if "duration" in work:
-        command += ["--duration", repr(work["duration"])]
-    tables, walls = {}, {}
-    for jobs in (1, workers):
-        times = []
+
+    def command(count):
+        c = [appell_cli, "sweep", str(work["scene"]), "--no-timing",
+             "--vary", f"{name}={float(values[0])!r}:{float(values[-1])!r}:{count}"]
+        if work.get("analysis") == "linearize":
+            c += ["--analysis", "linearize", "--cyclic", ",".join(work["cyclic"])]
+        if "duration" in work:
+            c += ["--duration", repr(work["duration"])]
+        return c
+
+    def timed(c):
+        times, out = [], None
         for _ in range(repeat):
             start = time.perf_counter()
-            out = subprocess.run(command + [f"-j{jobs}"], capture_output=True, check=True).stdout
+            out = subprocess.run(c, capture_output=True, check=True).stdout
             times.append(time.perf_counter() - start)
-        tables[jobs], walls[jobs] = out, statistics.median(times)
+        return out, statistics.median(times)
+
+    tables, walls = {}, {}
+    for jobs in (1, workers):
+        tables[jobs], walls[jobs] = timed(command(len(values)) + [f"-j{jobs}"])
     if tables[1] != tables[workers]:
         raise SystemExit("appell sweep: the tables of -j1 and -j%d differ" % workers)
-    print(f"{'appell -j1':>10} {walls[1]:9.3f}")
-    print(f"{f'appell -j{workers}':>10} {walls[workers]:9.3f} {walls[1] / walls[workers]:8.2f}×  (same bytes as -j1)",
-          flush=True)
+    fixed = timed(command(1) + ["-j1"])[1]
+    cases = (walls[1] - fixed) / (walls[workers] - fixed)
+    print(f"{'appell -j1':>10} {walls[1]:9.3f}   (one case alone: {fixed:.3f} s, the fixed cost)")
+    print(f"{f'appell -j{workers}':>10} {walls[workers]:9.3f} {walls[1] / walls[workers]:8.2f}×  (same bytes as -j1; "
+          f"the cases alone {cases:.2f}×)", flush=True)
 
 
 def main():
@@ -117,6 +131,8 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--executors", default="serial,threads,processes,dask")
+    ap.add_argument("--batch-size", type=int, help="cases per batch (default: appell.sweep's rule); "
+                                                   "1 measures an executor's cost per batch")
     ap.add_argument("--workloads", default="disk-runs,disk-linearizations,bicycle")
     ap.add_argument("--cli", help="also time `appell sweep` of the same workloads, -j1 against -jWORKERS, "
                                   "with this appell binary (build/cli/appell)")
@@ -148,7 +164,8 @@ def main():
             print(f"{'executor':>10} {'wall (s)':>9} {'speed-up':>9} {'overhead/case (ms)':>19} {'CPU/wall':>9}")
             serial, reference = None, None
             for executor in names:
-                wall, overhead, cpu, r = measure(work, pools[executor], args.workers, args.repeat, reference)
+                wall, overhead, cpu, r = measure(work, pools[executor], args.workers, args.repeat, reference,
+                                                 args.batch_size)
                 if executor == "serial":
                     serial, reference = wall, r
                 speedup = f"{serial / wall:8.2f}×" if serial else "        -"

@@ -188,6 +188,8 @@ def test_a_misspelt_parameter_is_an_error_before_anything_runs():
         appell.sweep(DISK, {"wobble": [1.0, 2.0]}, executor="threads", **RUN)
     with pytest.raises(ValueError, match="give its path"):
         appell.sweep(appell.load_scene(DISK), {"speed": [1.0]}, executor="processes", **RUN)
+    with pytest.raises(ValueError, match="batch_size must be a whole number ≥ 1, not 0"):
+        appell.sweep(DISK, {"speed": [1.0]}, executor="threads", batch_size=0, **RUN)
 
 
 def test_the_table_writes_to_csv_at_full_precision(tmp_path):
