@@ -85,6 +85,23 @@ def measure(work, executor, workers, repeat, reference, batch_size=None):
     return statistics.median(walls), statistics.median(overheads), statistics.median(cpus), r
 
 
+def empty_task(k):
+    return k
+
+
+def dask_round_trip(client, tasks):
+    """The least a Dask sweep costs: `tasks` tasks that do nothing, submitted
+    by one client.map and gathered — the messages client → scheduler →
+    workers → scheduler → client and the gather, each stream batching its
+    messages (2–10 ms intervals in distributed 2022.12)."""
+    times = []
+    for _ in range(21):
+        start = time.perf_counter()
+        client.gather(client.map(empty_task, range(tasks), pure=False))
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
 def cli_sweep(appell_cli, work, workers, repeat):
     """The same workload through `appell sweep` on 1 and on `workers` threads;
     the tables checked byte for byte equal (--no-timing). Also a sweep of
@@ -156,6 +173,8 @@ def main():
                                                        host="127.0.0.1", dashboard_address=None))
             pools["dask"] = stack.enter_context(Client(cluster))
             print(f"dask LocalCluster of {args.workers} workers: {time.perf_counter() - start:.2f} s to start")
+            print(f"dask round trip of {args.workers} empty tasks (client.map, gather): "
+                  f"{1e3 * dask_round_trip(pools['dask'], args.workers):.1f} ms, median of 21")
         chosen = args.workloads.split(",")
         for name, work in workloads(args.cases).items():
             if name not in chosen:
