@@ -83,12 +83,14 @@ def _scene_of(source, load_options):
     return _scenes[key]
 
 
-def _run_batch(source, load_options, analysis, options, cases):
+def _run_batch(source, load_options, analysis, options, cases, check_signals=False):
     """One batch of cases, run in C++ with the GIL released: its columns, one
-    entry per case in order (status and message as lists of str)."""
+    entry per case in order (status and message as lists of str).
+    ``check_signals``: Ctrl-C between two cases raises KeyboardInterrupt (a
+    batch on the main thread)."""
     scene = _scene_of(source, load_options)
     batch = _appell.run_batch if analysis == "run" else _appell.linearize_batch
-    return batch(scene, cases, **options)
+    return batch(scene, cases, check_signals=check_signals, **options)
 
 
 def _merge(tables):
@@ -308,7 +310,7 @@ class _SweepPlan:
         if batch_size is not None:
             return None, [slice(i, min(n, i + batch_size)) for i in range(0, n, batch_size)]
         start = time.perf_counter()
-        pilot = _run_batch(self.local, self.load_options, self.analysis, self.options, self.cases[:1])
+        pilot = _run_batch(self.local, self.load_options, self.analysis, self.options, self.cases[:1], True)
         seconds = time.perf_counter() - start
         count = _batch_count(n - 1, workers, seconds, MIN_BATCH_SECONDS[kind]) if n > 1 else 0
         return pilot, [slice(1 + s.start, 1 + s.stop) for s in _slices(n - 1, count)]
@@ -322,7 +324,7 @@ def _execute(sweep, executor, workers, batch_size):
     if not sweep.cases:
         return {}, "nothing"
     if isinstance(executor, str) and executor == "serial":
-        return _merge([_run_batch(*sweep.args(), sweep.cases)]), "serial"
+        return _merge([_run_batch(*sweep.args(), sweep.cases, True)]), "serial"
     if isinstance(executor, str) and executor in ("threads", "processes"):
         import concurrent.futures as cf
         import multiprocessing

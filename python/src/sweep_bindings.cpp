@@ -65,12 +65,19 @@ std::vector<OverrideList> readCases(const py::iterable& cases) {
 
 /// Runs `compute(case, row)` for every case without the GIL, timing each; a
 /// case that throws keeps only its status "error" and message (memory
-/// exhaustion ends the batch: MemoryError).
+/// exhaustion ends the batch: MemoryError). With `check_signals` (a batch
+/// run by the main thread: a serial sweep, the pilot case), Ctrl-C between
+/// two cases ends the batch with KeyboardInterrupt — taking the GIL for a
+/// moment per case, which a worker thread's batch does not.
 template <class Row, class Compute>
-std::vector<Row> runCases(const std::vector<OverrideList>& cases, const Compute& compute) {
+std::vector<Row> runCases(const std::vector<OverrideList>& cases, bool check_signals, const Compute& compute) {
   std::vector<Row> rows(cases.size());
   py::gil_scoped_release release;
   for (std::size_t k = 0; k < cases.size(); ++k) {
+    if (check_signals && k > 0) {
+      py::gil_scoped_acquire acquire;
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
     const auto start = std::chrono::steady_clock::now();
     try {
       compute(cases[k], rows[k]);
@@ -215,18 +222,18 @@ void bindRunBatch(py::module_& m) {
   m.def("run_batch", [](const Scene& base, const py::iterable& cases, std::optional<double> duration,
                         std::optional<double> dt, std::optional<double> tol, std::optional<std::string> integrator,
                         std::optional<std::string> formulation, double max_energy_error, double max_residual,
-                        double settle_time, bool project, bool project_initial) {
+                        double settle_time, bool project, bool project_initial, bool check_signals) {
         const RunKnobs knobs{duration, dt, tol, integrator, formulation, max_energy_error, max_residual,
                              settle_time, project, project_initial};
         const std::vector<OverrideList> list = readCases(cases);
-        const auto rows = runCases<RunRow>(list, [&](const OverrideList& overrides, RunRow& row) {
+        const auto rows = runCases<RunRow>(list, check_signals, [&](const OverrideList& overrides, RunRow& row) {
           fillRunRow(runCase(base, overrides, knobs, true), row);
         });
         return runColumns(rows, base);
       }, "scene"_a, "cases"_a, py::kw_only(), "duration"_a = py::none(), "dt"_a = py::none(),
       "tol"_a = py::none(), "integrator"_a = py::none(), "formulation"_a = py::none(),
       "max_energy_error"_a = 5e-2, "max_residual"_a = 1e-6, "settle_time"_a = ContactEventOptions{}.settle_time,
-      "project"_a = true, "project_initial"_a = false,
+      "project"_a = true, "project_initial"_a = false, "check_signals"_a = false,
       "run(scene, case, …) of every case (a list of (name, value) overrides each), the GIL released for the "
       "whole batch: a dict of columns, one entry per case (appell.sweep's batches).");
 }
@@ -234,7 +241,7 @@ void bindRunBatch(py::module_& m) {
 void bindLinearizeBatch(py::module_& m) {
   m.def("linearize_batch", [](const Scene& base, const py::iterable& cases, std::optional<std::string> formulation,
                               std::optional<VecX> tau, double time, const py::iterable& cyclic, double fd_step,
-                              double rank_tolerance) {
+                              double rank_tolerance, bool check_signals) {
         LinearizeKnobs knobs;
         knobs.formulation = formulation;
         knobs.tau = tau;
@@ -243,7 +250,8 @@ void bindLinearizeBatch(py::module_& m) {
         knobs.fd_step = fd_step;
         knobs.rank_tolerance = rank_tolerance;
         const std::vector<OverrideList> list = readCases(cases);
-        const auto rows = runCases<LinearizeRow>(list, [&](const OverrideList& overrides, LinearizeRow& row) {
+        const auto rows = runCases<LinearizeRow>(list, check_signals, [&](const OverrideList& overrides,
+                                                                          LinearizeRow& row) {
           OverrideReport report;
           Scene scene = overriddenScene(base, overrides, report);
           checkInitialState(scene, false, 1e-8);  // apply_overrides' check, its defaults
@@ -261,6 +269,7 @@ void bindLinearizeBatch(py::module_& m) {
         return linearizeColumns(rows, base);
       }, "scene"_a, "cases"_a, py::kw_only(), "formulation"_a = py::none(), "tau"_a = py::none(),
       "time"_a = 0.0, "cyclic"_a = py::tuple(), "fd_step"_a = 1e-5, "rank_tolerance"_a = 1e-9,
+      "check_signals"_a = false,
       "apply_overrides(scene, case) then linearize at its initial state, for every case, the GIL released "
       "for the whole batch: a dict of columns, one entry per case (appell.sweep's batches).");
 }
