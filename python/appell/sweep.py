@@ -139,7 +139,7 @@ class SweepResult:
         self.columns = {}
         for name in self.parameters:  # NaN where a case given one by one leaves a name out
             values = [dict(c).get(name) for c in cases]
-            width = max((np.size(v) for v in values if v is not None), default=1)
+            width = max((len(v) if hasattr(v, "__len__") else 1 for v in values if v is not None), default=1)
             nan = np.nan if width == 1 else [np.nan] * width
             self.columns[name] = np.array([nan if v is None else v for v in values], dtype=float)
         self.columns.update(columns)
