@@ -217,7 +217,7 @@ def sweep(scene, parameters=None, *, samples=None, seed=None, cases=None, analys
                 worker threads)
     batch_size  cases per batch (default: ``_batch_count``'s rule — from
                 the first case's wall time, batches of at least 5 ms on
-                threads, 20 ms on processes and 50 ms on Dask, up to four
+                threads, 20 ms on processes and 100 ms on Dask, up to four
                 per worker; docs/python.md)
     """
     if analysis not in ("run", "linearize"):
@@ -265,12 +265,14 @@ def _check_names(scene, cases):
 
 
 # The least work a batch should carry, by executor, against its own cost per
-# batch (measured on 2 cores, python/bench/results.md): a thread pays ~0.1 ms
-# (the call, reading the cases, building the columns, the future), a spawned
-# process ~0.5 ms (pickling the batch and its table, the pipe), a Dask task
-# ~1–2 ms (the scheduler's bookkeeping and its messages, the worker's). These
-# keep that cost to a few per cent of the batch.
-MIN_BATCH_SECONDS = {"threads": 0.005, "processes": 0.02, "dask": 0.05}
+# batch — measured with batches of one bicycle linearization on one worker
+# (python/bench/results.md): 0.10 ms on a thread (the call, reading the
+# cases, building the columns, the future), 0.5 ms on a spawned process
+# (pickling the batch and its table, the pipe), 4 ms for a Dask task on a
+# LocalCluster (the scheduler's bookkeeping and the messages between client,
+# scheduler and worker; Dask's own guidance is ~1 ms per task and tasks of
+# ~100 ms, "Dask Best Practices"). Each keeps that cost to 2–4 % of a batch.
+MIN_BATCH_SECONDS = {"threads": 0.005, "processes": 0.02, "dask": 0.1}
 BATCHES_PER_WORKER = 4
 
 

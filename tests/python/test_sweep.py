@@ -77,20 +77,23 @@ def test_every_cut_into_batches_gives_the_serial_numbers_in_case_order(executor,
 
 def test_batch_count_rule():
     count = sweep_module._batch_count
+    dask, threads = sweep_module.MIN_BATCH_SECONDS["dask"], sweep_module.MIN_BATCH_SECONDS["threads"]
+    assert (dask, threads) == (0.1, 0.005)
     # 200 bicycle linearizations (0.25 ms each) on 2 Dask workers: 50 ms of
-    # work holds one 50 ms batch per worker at most — so one each.
-    assert count(200, 2, 0.25e-3, 0.05) == 2
+    # work does not fill one 100 ms batch per worker — so one each.
+    assert count(200, 2, 0.25e-3, dask) == 2
     # 200 disk runs (4.6 ms each): 920 ms, four batches per worker.
-    assert count(200, 2, 4.6e-3, 0.05) == 8
+    assert count(200, 2, 4.6e-3, dask) == 8
     # Threads (5 ms batches) cut the bicycle's 50 ms into 8.
-    assert count(200, 2, 0.25e-3, 0.005) == 8
+    assert count(200, 2, 0.25e-3, threads) == 8
     # Never more batches than cases, never fewer than one; a multiple of the workers between.
-    assert count(3, 4, 1.0, 0.05) == 3
-    assert count(1, 8, 1e-6, 0.05) == 1
-    # 10⁵ of them on 100 workers: 25 s, four batches of 62 ms per worker;
-    # 10⁴: 2.5 s, one of 25 ms per worker — every worker busy before 50 ms each.
-    assert count(10**5, 100, 0.25e-3, 0.05) == 400
-    assert count(10**4, 100, 0.25e-3, 0.05) == 100
+    assert count(3, 4, 1.0, dask) == 3
+    assert count(1, 8, 1e-6, dask) == 1
+    # 10⁵ of them on 100 workers: 25 s, two batches of 125 ms per worker;
+    # 10⁴: 2.5 s, one of 25 ms per worker — every worker busy before 100 ms each.
+    assert count(10**5, 100, 0.25e-3, dask) == 200
+    assert count(10**4, 100, 0.25e-3, dask) == 100
+    assert count(10**6, 100, 0.25e-3, dask) == 400
     slices = sweep_module._slices(199, 8)
     sizes = [s.stop - s.start for s in slices]
     assert slices[0].start == 0 and slices[-1].stop == 199 and max(sizes) - min(sizes) <= 1
