@@ -9,7 +9,7 @@ computation as ``appell.run(scene, overrides)`` (or ``appell.linearize`` of
 the overridden scene) called alone, so its numbers equal those bit for bit
 whatever the executor.
 
-Cases travel in batches: a batch is a contiguous slice of the case list,
+Cases travel in batches: a batch is every k-th case of the list (_strides),
 run by one call into the extension (``_appell.run_batch`` /
 ``linearize_batch``) with the GIL released for the whole batch, its table
 coming back as NumPy columns — no Python runs per case, so threads never
@@ -93,10 +93,11 @@ def _run_batch(source, load_options, analysis, options, cases, check_signals=Fal
     return batch(scene, cases, check_signals=check_signals, **options)
 
 
-def _merge(tables):
-    """The batches' columns joined in order: a 2-D column padded with NaN to
-    its widest batch (the spectra of linearizations of different dimension);
-    counts become floats with NaN where a case ended in an error."""
+def _merge(tables, order=None):
+    """The batches' columns joined, row j being case order[j] (default: in
+    turn), and put in case order: a 2-D column padded with NaN to its widest
+    batch (the spectra of linearizations of different dimension); counts
+    become floats with NaN where a case ended in an error."""
     columns = {}
     for key in tables[0]:
         parts = [t[key] for t in tables]
@@ -109,6 +110,9 @@ def _merge(tables):
             columns[key] = np.concatenate(parts)
         else:
             columns[key] = np.concatenate(parts)
+    if order is not None:
+        rows = np.argsort(np.asarray(order), kind="stable")  # rows[k]: the row of case k
+        columns = {key: col[rows] for key, col in columns.items()}
     errors = columns["status"] == "error"
     if errors.any():
         for key, col in columns.items():
@@ -287,10 +291,13 @@ def _batch_count(cases, workers, case_seconds, min_batch_seconds):
     return max(1, min(cases, workers * per_worker))
 
 
-def _slices(n, count):
-    """``count`` contiguous slices of range(n), their lengths within one."""
-    bounds = [n * i // count for i in range(count + 1)]
-    return [slice(bounds[i], bounds[i + 1]) for i in range(count)]
+def _strides(first, n, count):
+    """``count`` batches of the cases first … n − 1, batch i taking every
+    count-th case from first + i — not contiguous slices: along a grid the
+    cost of a case often grows (a faster run takes more steps), and strided
+    batches share that gradient alike, so that equal batches end together.
+    Their sizes are within one of each other."""
+    return [range(first + i, n, count) for i in range(count)]
 
 
 class _SweepPlan:
@@ -307,19 +314,25 @@ class _SweepPlan:
 
     def batches(self, workers, batch_size, kind):
         """The first case's table (the pilot, run here and timed, when the
-        batch size is to be chosen; None else) and the slices of the rest."""
+        batch size is to be chosen; None else) and the case indices of each
+        batch of the rest (_strides)."""
         n = len(self.cases)
         if batch_size is not None:
-            return None, [slice(i, min(n, i + batch_size)) for i in range(0, n, batch_size)]
+            return None, _strides(0, n, -(-n // batch_size))
         start = time.perf_counter()
         pilot = _run_batch(self.local, self.load_options, self.analysis, self.options, self.cases[:1], True)
         seconds = time.perf_counter() - start
         count = _batch_count(n - 1, workers, seconds, MIN_BATCH_SECONDS[kind]) if n > 1 else 0
-        return pilot, [slice(1 + s.start, 1 + s.stop) for s in _slices(n - 1, count)]
+        return pilot, _strides(1, n, count)
+
+    def cases_of(self, indices):
+        return [self.cases[k] for k in indices]
 
 
-def _gathered(pilot, tables):
-    return _merge(([pilot] if pilot is not None else []) + list(tables))
+def _gathered(pilot, batches, tables):
+    """The pilot's and the batches' tables as one, in case order."""
+    order = ([0] if pilot is not None else []) + [k for b in batches for k in b]
+    return _merge(([pilot] if pilot is not None else []) + list(tables), order)
 
 
 def _execute(sweep, executor, workers, batch_size):
@@ -360,9 +373,9 @@ def _execute(sweep, executor, workers, batch_size):
 
 
 def _on_pool(pool, sweep, workers, batch_size, kind):
-    pilot, slices = sweep.batches(workers, batch_size, kind)
-    futures = [pool.submit(_run_batch, *sweep.args(), sweep.cases[s]) for s in slices]
-    return _gathered(pilot, [f.result() for f in futures])
+    pilot, batches = sweep.batches(workers, batch_size, kind)
+    futures = [pool.submit(_run_batch, *sweep.args(), sweep.cases_of(b)) for b in batches]
+    return _gathered(pilot, batches, [f.result() for f in futures])
 
 
 class _Batch:
@@ -383,7 +396,7 @@ def _on_client(client, sweep, workers, batch_size):
     """One Dask task per batch, submitted by one client.map (one message to
     the scheduler, where a submit per batch would wait out the client's 10 ms
     batching of messages after the first)."""
-    pilot, slices = sweep.batches(workers, batch_size, "dask")
-    tasks = [_Batch(sweep.args(), sweep.cases[s]) for s in slices]
+    pilot, batches = sweep.batches(workers, batch_size, "dask")
+    tasks = [_Batch(sweep.args(), sweep.cases_of(b)) for b in batches]
     futures = client.map(_run_task, tasks, pure=False)
-    return _gathered(pilot, client.gather(futures))
+    return _gathered(pilot, batches, client.gather(futures))

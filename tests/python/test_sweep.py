@@ -94,10 +94,13 @@ def test_batch_count_rule():
     assert count(10**5, 100, 0.25e-3, dask) == 200
     assert count(10**4, 100, 0.25e-3, dask) == 100
     assert count(10**6, 100, 0.25e-3, dask) == 400
-    slices = sweep_module._slices(199, 8)
-    sizes = [s.stop - s.start for s in slices]
-    assert slices[0].start == 0 and slices[-1].stop == 199 and max(sizes) - min(sizes) <= 1
-    assert all(a.stop == b.start for a, b in zip(slices, slices[1:]))
+    # Strided batches: every case once, sizes within one, each batch a
+    # sample of the whole range (the cost gradient of a grid shared alike).
+    batches = sweep_module._strides(1, 200, 8)
+    cases = sorted(k for b in batches for k in b)
+    sizes = [len(b) for b in batches]
+    assert cases == list(range(1, 200)) and max(sizes) - min(sizes) <= 1
+    assert list(batches[0][:3]) == [1, 9, 17] and list(batches[-1][:2]) == [8, 16]
 
 
 def test_a_case_that_fails_inside_a_batch_is_its_row_alone():
