@@ -22,7 +22,6 @@ file once per process, so the scene is given as a path there.
 from __future__ import annotations
 
 import itertools
-import math
 import numbers
 import os
 import time
