@@ -6,7 +6,8 @@
 //       E(t) + impact losses + friction work − joint work − support work = E₀,
 //     the residuals, the final state, and every contact event with the states
 //     around it, as NumPy arrays.
-// Sweeps (python/appell/sweep.py) are made of these two calls.
+// A sweep's batches (sweep_bindings.cpp) run the same cases by the same code
+// (case_runs.cpp).
 #include "case_runs.hpp"
 
 #include <appell/contact_events.hpp>
