@@ -1,6 +1,6 @@
 // Equilibria (equilibria.hpp) and linearization (linearization.hpp) of a
 // scene, with the GIL released while they run.
-#include "bindings.hpp"
+#include "case_runs.hpp"
 
 #include <appell/equilibria.hpp>
 #include <appell/linearization.hpp>
@@ -31,28 +31,6 @@ EquilibriumOptions equilibriumOptions(const Scene& s, const std::optional<VecX>&
   o.fd_step = fd_step;
   o.rank_tolerance = rank_tolerance;
   return o;
-}
-
-/// Cyclic coordinates by velocity index, or by name — a velocity's
-/// (Scene.velocity_names) or a position's (localCoordinateIndex, joint_types.hpp).
-std::vector<int> cyclicIndices(const Scene& s, const py::iterable& cyclic) {
-  std::vector<int> out;
-  for (py::handle c : cyclic) {
-    if (py::isinstance<py::str>(c)) {
-      const std::string n = c.cast<std::string>();
-      int k;
-      try {
-        k = localCoordinateIndex(s.model, n);
-      } catch (const std::invalid_argument& e) {
-        throw py::key_error(e.what());
-      }
-      if (k < 0) throw py::key_error("no coordinate named '" + n + "'");
-      out.push_back(k);
-    } else {
-      out.push_back(c.cast<int>());
-    }
-  }
-  return out;
 }
 
 void bindResults(py::module_& m) {
@@ -129,17 +107,16 @@ void bindAnalysis(py::module_& m) {
   m.def("linearize", [](const Scene& s, std::optional<VecX> q, std::optional<VecX> v,
                         std::optional<std::string> formulation, std::optional<VecX> tau, double time,
                         const py::iterable& cyclic, double fd_step, double rank_tolerance) {
-        LinearizationOptions o;
-        o.tau = tau ? *tau : sceneTau(s);
-        o.time = time;
-        o.cyclic = cyclicIndices(s, cyclic);
-        o.fd_step = fd_step;
-        o.rank_tolerance = rank_tolerance;
-        const Formulation f = formulationFromString(formulation.value_or(s.settings.formulation));
+        LinearizeKnobs knobs;
+        knobs.formulation = formulation;
+        knobs.tau = tau;
+        knobs.time = time;
+        knobs.cyclic = cyclicIndices(s, cyclic);
+        knobs.fd_step = fd_step;
+        knobs.rank_tolerance = rank_tolerance;
         const VecX qq = q ? *q : s.q0, vv = v ? *v : s.v0;
         py::gil_scoped_release release;
-        auto solver = makeSolver(f, s.model, s.constraints);
-        return linearize(s.model, s.constraints, *solver, qq, vv, o);
+        return linearizeScene(s, qq, vv, knobs);
       }, "scene"_a, "q"_a = py::none(), "v"_a = py::none(), py::kw_only(), "formulation"_a = py::none(),
         "tau"_a = py::none(), "time"_a = 0.0, "cyclic"_a = py::tuple(), "fd_step"_a = 1e-5,
         "rank_tolerance"_a = 1e-9,

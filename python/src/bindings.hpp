@@ -1,6 +1,6 @@
 // The pieces of the _appell extension module, one file each: scene loading
 // and names (scene_bindings.cpp), simulation (simulation_bindings.cpp), whole
-// runs and overrides (run_bindings.cpp),
+// runs and overrides (run_bindings.cpp), a sweep's batches (sweep_bindings.cpp),
 // equilibria and linearization (analysis_bindings.cpp), and the helpers they
 // share.
 #pragma once
@@ -21,6 +21,7 @@ void bindScene(py::module_& m);
 void bindSimulation(py::module_& m);
 void bindAnalysis(py::module_& m);
 void bindRun(py::module_& m);
+void bindSweep(py::module_& m);
 
 /// Index of a constraint given by index (negative from the end, as Python
 /// does) or by name; IndexError / KeyError otherwise.

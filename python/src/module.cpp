@@ -48,4 +48,5 @@ PYBIND11_MODULE(_appell, m) {
   appell::python::bindSimulation(m);
   appell::python::bindAnalysis(m);
   appell::python::bindRun(m);
+  appell::python::bindSweep(m);
 }

@@ -6,8 +6,9 @@
 //       E(t) + impact losses + friction work − joint work − support work = E₀,
 //     the residuals, the final state, and every contact event with the states
 //     around it, as NumPy arrays.
-// Sweeps (python/appell/sweep.py) are made of these two calls.
-#include "bindings.hpp"
+// A sweep's batches (sweep_bindings.cpp) run the same cases by the same code
+// (case_runs.cpp).
+#include "case_runs.hpp"
 
 #include <appell/contact_events.hpp>
 #include <appell/overrides.hpp>
@@ -27,128 +28,10 @@ using namespace pybind11::literals;
 
 namespace {
 
-/// A run's summary, its final state and its events with the states around them.
-struct RunResult {
-  RunSummary summary;
-  VecX q, v;
-  double energy = 0, kinetic = 0;
-  /// Per event: the last state the run passed before it (the start of the
-  /// step the event ended, at t_before) and the state at the event, after
-  /// its impulse (the end of that step).
-  std::vector<double> t_before;
-  std::vector<VecX> q_before, v_before, q_after, v_after;
-  int nq = 0, nv = 0;
-  std::vector<std::string> overrides;
-};
-
 MatX rows(const std::vector<VecX>& x, int n) {
   MatX out(x.size(), n);
   for (std::size_t k = 0; k < x.size(); ++k) out.row(k) = x[k].transpose();
   return out;
-}
-
-/// The scene with `overrides` (name → number or sequence, in order) applied
-/// and its velocities completed; `describe`'s lines.
-// The Python overrides as (name, values), read with the GIL held.
-std::vector<std::pair<std::string, std::vector<double>>> overrideList(py::handle overrides) {
-  std::vector<std::pair<std::string, std::vector<double>>> out;
-  if (overrides.is_none()) return out;
-  py::object items = py::isinstance<py::dict>(overrides) ? overrides.attr("items")() : py::reinterpret_borrow<py::object>(overrides);
-  for (py::handle item : items) {
-    auto pair = item.cast<py::tuple>();
-    if (pair.size() != 2) throw py::value_error("an override is a (name, value) pair");
-    const std::string name = pair[0].cast<std::string>();
-    if (py::isinstance<py::str>(pair[1]))
-      throw py::value_error(name + ": give a number or a sequence of numbers, not a string");
-    out.emplace_back(name, py::hasattr(pair[1], "__len__") ? pair[1].cast<std::vector<double>>()
-                                                           : std::vector<double>{pair[1].cast<double>()});
-  }
-  return out;
-}
-
-// A copy of the scene with the overrides applied and the velocities
-// completed. Everything but reading the Python objects runs with the GIL
-// released — the scene's copy (its model, constraints and meshes) included —
-// so that the cases of a threaded sweep do not take turns here.
-std::pair<std::shared_ptr<Scene>, std::vector<std::string>> withOverrides(const Scene& base, py::handle overrides,
-                                                                         OverrideReport* report_out = nullptr) {
-  const auto list = overrideList(overrides);
-  std::shared_ptr<Scene> scene;
-  OverrideReport report;
-  std::vector<std::string> lines;
-  {
-    py::gil_scoped_release release;
-    scene = std::make_shared<Scene>(base);
-    for (const auto& [name, values] : list) applyOverride(*scene, name, values, report);
-    completeVelocities(*scene, report);
-    lines = describe(*scene, report);
-  }
-  if (report_out) *report_out = report;
-  return {scene, lines};
-}
-
-RunOptions options(const Scene& s, std::optional<double> duration, std::optional<double> dt,
-                   std::optional<double> tol, std::optional<std::string> integrator,
-                   std::optional<std::string> formulation, double max_energy_error, double max_residual,
-                   double settle_time, bool project) {
-  SimulationSettings settings = s.settings;
-  if (duration) settings.duration = *duration;
-  if (dt) settings.dt = *dt;
-  if (tol) settings.tol = *tol;
-  if (integrator) settings.integrator = *integrator;
-  if (formulation) settings.formulation = *formulation;
-  RunOptions o = runOptions(settings);
-  o.max_energy_error = max_energy_error;
-  o.max_residual = max_residual;
-  if (!(settle_time >= 0) || !std::isfinite(settle_time))
-    throw std::invalid_argument("settle_time must be a finite number ≥ 0, not " + std::to_string(settle_time));
-  o.settle_time = settle_time;
-  o.project_positions = o.project_velocities = project;
-  o.output_every = 1 << 30;  // only the first and last states are sampled
-  return o;
-}
-
-/// runScene, keeping the final state and the states around each event.
-RunResult runWithEvents(const Scene& scene, const RunOptions& o) {
-  RunResult r;
-  double t_prev = 0;
-  VecX q_prev = scene.q0, v_prev = scene.v0;  // sized once: assignments reuse them
-  auto on_step = [&](const Simulator& sim) {
-    for (std::size_t k = 0; k < sim.events().size(); ++k) {
-      r.t_before.push_back(t_prev);
-      r.q_before.push_back(q_prev);
-      r.v_before.push_back(v_prev);
-      r.q_after.push_back(sim.q());
-      r.v_after.push_back(sim.v());
-    }
-    t_prev = sim.time();
-    q_prev = sim.q();
-    v_prev = sim.v();
-  };
-  bool first = true;
-  auto on_sample = [&](const Simulator& sim) {
-    if (first) {  // t = 0: events of the initial state (a contact opening at once)
-      for (std::size_t k = 0; k < sim.events().size(); ++k) {
-        r.t_before.push_back(0);
-        r.q_before.push_back(scene.q0);
-        r.v_before.push_back(scene.v0);
-        r.q_after.push_back(sim.q());
-        r.v_after.push_back(sim.v());
-      }
-      t_prev = sim.time();
-      q_prev = sim.q();
-      v_prev = sim.v();
-      first = false;
-    }
-    r.q = sim.q();
-    r.v = sim.v();
-    r.energy = sim.energy();
-    r.kinetic = sim.kineticEnergy();
-  };
-  r.summary = runScene(scene, o, on_sample, on_step);
-  r.nq = scene.model.nq;
-  r.nv = scene.model.nv;
-  return r;
 }
 
 py::dict eventTable(const RunResult& r) {
@@ -236,10 +119,15 @@ void bindRun(py::module_& m) {
   bindRunResult(m);
   m.def("apply_overrides", [](const Scene& s, py::handle overrides, bool check_initial_state, bool project,
                               double tol) {
-        auto [scene, lines] = withOverrides(s, overrides);
-        if (check_initial_state) {
+        const OverrideList list = readOverrides(overrides);
+        std::shared_ptr<Scene> scene;
+        std::vector<std::string> lines;
+        {  // the scene's copy (model, constraints, meshes) too: threads do not take turns here
           py::gil_scoped_release release;
-          checkInitialState(*scene, project, tol);
+          OverrideReport report;
+          scene = std::make_shared<Scene>(overriddenScene(s, list, report));
+          lines = describe(*scene, report);
+          if (check_initial_state) checkInitialState(*scene, project, tol);
         }
         return py::make_tuple(scene, lines);
       }, "scene"_a, "overrides"_a, py::kw_only(), "check_initial_state"_a = true, "project"_a = false,
@@ -250,15 +138,15 @@ void bindRun(py::module_& m) {
                   std::optional<double> tol, std::optional<std::string> integrator,
                   std::optional<std::string> formulation, double max_energy_error, double max_residual,
                   double settle_time, bool project, bool project_initial) {
-        auto [scene, lines] = withOverrides(s, overrides);
-        const RunOptions o = options(*scene, duration, dt, tol, integrator, formulation, max_energy_error,
-                                     max_residual, settle_time, project);
-        RunResult r;
+        const RunKnobs knobs{duration, dt, tol, integrator, formulation, max_energy_error, max_residual,
+                             settle_time, project, project_initial};
+        const OverrideList list = readOverrides(overrides);
         const bool check = !overrides.is_none();  // the loader checked the scene's own state
+        RunResult r;
+        std::vector<std::string> lines;
         {
           py::gil_scoped_release release;
-          if (check) checkInitialState(*scene, project_initial, LoadOptions().initial_state_tolerance);
-          r = runWithEvents(*scene, o);
+          r = runCase(s, list, knobs, check, &lines);
         }
         r.overrides = lines;
         return r;
