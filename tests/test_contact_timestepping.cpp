@@ -50,6 +50,39 @@ Vec3 worldLinear(const Simulator& sim) {
   return floatingRotation(sim.q(), 0) * Vec3(sim.v().tail<3>());
 }
 
+// Time-stepping of the pushed box: four corners on one face are redundant,
+// Gauss–Seidel creeps at the slip onset, so the problem is solved to 1e-8
+// m/s or 500 sweeps.
+SimulatorOptions pushedBoxScheme(double h) {
+  SimulatorOptions so = scheme(ContactScheme::TimeStepping, h);
+  so.timestepping.residual_tol = 1e-8;
+  so.timestepping.max_sweeps = 500;
+  return so;
+}
+
+// Pushes the box at its centre by F = k t from rest to T in steps of h; the
+// time its speed first passes 1e-6 m/s (sticking holds the slip to the
+// residual, 1e-8 m/s), −1 if never, NaN (and a test failure) if a step fails.
+double pushBox(Simulator& sim, const BoxScene& s, double k, double T, double h) {
+  sim.setJointForces([k](double t, const VecX& q, const VecX&, VecX& tau) {
+    tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
+  });
+  if (!sim.setState(0, s.q0, s.v0)) {
+    ADD_FAILURE() << sim.lastStateError();
+    return std::nan("");
+  }
+  double t_slip = -1;
+  while (sim.time() < T - 1e-12) {
+    const StepStatus st = sim.step(std::min(h, T - sim.time()));
+    if (!st.ok) {
+      ADD_FAILURE() << st.message;
+      return std::nan("");
+    }
+    if (t_slip < 0 && worldLinear(sim).x() > 1e-6) t_slip = sim.time();
+  }
+  return t_slip;
+}
+
 }  // namespace
 
 // Protects the Moreau–Jean step against the closed form of a box on four
@@ -65,24 +98,9 @@ TEST(ContactTimeStepping, BoxPushedToSlidingOnFourCorners) {
   for (double h : {1e-3, 5e-4}) {
     SCOPED_TRACE("h = " + std::to_string(h));
     BoxScene s = box(0, ContactKind::Rolling, mu);
-    // Four corners on one face are redundant: Gauss–Seidel creeps at the
-    // slip onset, so the problem is solved to 1e-8 m/s or 500 sweeps.
-    SimulatorOptions so = scheme(ContactScheme::TimeStepping, h);
-    so.timestepping.residual_tol = 1e-8;
-    so.timestepping.max_sweeps = 500;
     Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
-                  IntegratorType::RK4, {}, so);
-    sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
-      tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
-    });
-    ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
-    double t_slip = -1;
-    while (sim.time() < T - 1e-12) {
-      const StepStatus st = sim.step(std::min(h, T - sim.time()));
-      ASSERT_TRUE(st.ok) << st.message;
-      // (Sticking holds the slip to the residual, 1e-8 m/s.)
-      if (t_slip < 0 && worldLinear(sim).x() > 1e-6) t_slip = sim.time();
-    }
+                  IntegratorType::RK4, {}, pushedBoxScheme(h));
+    const double t_slip = pushBox(sim, s, k, T, h);
     EXPECT_EQ(sim.counters().timestepping_steps, std::lround(T / h));
     std::cout << "h = " << h << ": " << sim.counters().unconverged << " problems at max sweeps, "
               << "largest residual " << sim.counters().max_contact_residual << " m/s\n";
@@ -115,21 +133,9 @@ TEST(ContactTimeStepping, BoxSticksOnTheStaticConeAndSlidesOnTheKinetic) {
   const double mu_s = 0.5, mu_k = 0.3, k = 30.0, T = 0.7, h = 1e-3;
   const double t_star = mu_s * kMass * kG / k;
   BoxScene s = cornerBox({.half = kHalf, .mass = kMass, .mu = mu_s, .mu_kinetic = mu_k});
-  SimulatorOptions so = scheme(ContactScheme::TimeStepping, h);
-  so.timestepping.residual_tol = 1e-8;
-  so.timestepping.max_sweeps = 500;
   Simulator sim(s.model, s.constraints, makeSolver(Formulation::Tree, s.model, s.constraints),
-                IntegratorType::RK4, {}, so);
-  sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {
-    tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(k * t, 0, 0);
-  });
-  ASSERT_TRUE(sim.setState(0, s.q0, s.v0)) << sim.lastStateError();
-  double t_slip = -1;
-  while (sim.time() < T - 1e-12) {
-    const StepStatus st = sim.step(std::min(h, T - sim.time()));
-    ASSERT_TRUE(st.ok) << st.message;
-    if (t_slip < 0 && worldLinear(sim).x() > 1e-6) t_slip = sim.time();
-  }
+                IntegratorType::RK4, {}, pushedBoxScheme(h));
+  const double t_slip = pushBox(sim, s, k, T, h);
   EXPECT_NEAR(t_slip, t_star, 2 * h + 1e-12) << "slip starts where F reaches μₛ m g";
   const double v = (k * (T * T - t_star * t_star) / 2 - mu_k * kMass * kG * (T - t_star)) / kMass;
   EXPECT_NEAR(worldLinear(sim).x(), v, 10 * h * k / kMass * (T - t_star)) << "slides against μₖ m g";

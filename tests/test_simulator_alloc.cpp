@@ -225,6 +225,32 @@ std::unique_ptr<ConstrainedSolver> solverNumber(int which, const Model& model,
   return makeSolver(Formulation::Tree, model, c);
 }
 
+// The ball with friction μ on the plane, launched sliding at 1 m/s without
+// spin (it sticks at t = 2v₀/(7μg)), and pushed along x by F = k (t − 0.2 s)
+// from 0.2 s: it slips again when (2/7)F reaches μmg, near
+// 0.2 + 3.5 μmg/k. Shared by the friction tests of the two schemes.
+constexpr double kPushStart = 0.2, kPushRate = 20.0;
+struct PushedBall {
+  BallOnPlane s;
+  VecX q, v;
+};
+PushedBall pushedBall(double mu) {
+  ContactSpec spec;
+  spec.mu = mu;
+  PushedBall b{ballOnPlane(spec), {}, {}};
+  b.q = neutralConfiguration(b.s.model);
+  b.q[2] = kBallRadius;
+  b.v = VecX::Zero(b.s.model.nv);
+  b.v[3] = 1.0;
+  return b;
+}
+void push(Simulator& sim) {
+  sim.setJointForces([](double t, const VecX& qq, const VecX&, VecX& tau) {
+    const double F = t > kPushStart ? kPushRate * (t - kPushStart) : 0.0;
+    tau.tail<3>() = scenes::floatingRotation(qq, 0).transpose() * Vec3(F, 0, 0);
+  });
+}
+
 // Steps that hold contact events (touchdown, impacts, the active set
 // changing, bounces) allocate nothing either: every row has its storage from
 // the start and the event list is reserved. A ball with restitution 0.5
@@ -290,29 +316,19 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
 // that contact forced) and slides on, its first instants on the settled
 // direction — every workspace sized when the simulator is built.
 TEST(SimulatorAllocation, FrictionEventsDoNotAllocate) {
-  const double r = kBallRadius, m = kBallMass, g = 9.81, mu = 0.3, k = 20.0;
-  ContactSpec spec;
-  spec.mu = mu;
-  const BallOnPlane s = ballOnPlane(spec);
-  const Model& model = s.model;
-  const ConstraintList& c = s.constraints;
-  VecX q = neutralConfiguration(model);
-  q[2] = r;
-  VecX v = VecX::Zero(model.nv);
-  v[3] = 1.0;  // sliding without spin: it sticks at t = 2v₀/(7μg) ≈ 0.097 s
+  const double mu = 0.3;
+  const PushedBall b = pushedBall(mu);  // sticks at t ≈ 0.097 s, pushed from 0.2 s
+  const Model& model = b.s.model;
+  const ConstraintList& c = b.s.constraints;
   for (int which = 0; which < 3; ++which) {
     for (IntegratorType it : {IntegratorType::Leapfrog, IntegratorType::RK4,
                               IntegratorType::DormandPrince54}) {
       std::unique_ptr<ConstrainedSolver> solver = solverNumber(which, model, c);
       Simulator sim(model, c, std::move(solver), it);
-      // The push starts at 0.2 s; it slips when (2/7)F reaches μmg.
-      sim.setJointForces([&](double t, const VecX& qq, const VecX&, VecX& tau) {
-        const double F = t > 0.2 ? k * (t - 0.2) : 0.0;
-        tau.tail<3>() = scenes::floatingRotation(qq, 0).transpose() * Vec3(F, 0, 0);
-      });
-      ASSERT_TRUE(sim.setState(0, q, v));
+      push(sim);
+      ASSERT_TRUE(sim.setState(0, b.q, b.v));
       long allocations = 0, slips = 0, sticks = 0;
-      const double t_end = 0.2 + 3.5 * mu * m * g / k + 0.1;
+      const double t_end = kPushStart + 3.5 * mu * kBallMass * 9.81 / kPushRate + 0.1;
       // 0.1 s past the slip: the slip's first instants slide on the settled
       // direction (friction_settled.cpp), whose solves allocate nothing either.
       while (sim.time() < t_end) {
@@ -342,27 +358,18 @@ TEST(SimulatorAllocation, FrictionEventsDoNotAllocate) {
 // 2v₀/(7μg) ≈ 0.097 s and is pushed from 0.2 s until it slips again — every
 // mode a contact takes in a window (slide, stick, slide), in each solver.
 TEST(SimulatorAllocation, TimeSteppingStepsDoNotAllocate) {
-  const double mu = 0.3, k = 20.0;
-  ContactSpec spec;
-  spec.mu = mu;
-  const BallOnPlane s = ballOnPlane(spec);
-  const Model& model = s.model;
-  const ConstraintList& c = s.constraints;
-  VecX q = neutralConfiguration(model);
-  q[2] = kBallRadius;
-  VecX v = VecX::Zero(model.nv);
-  v[3] = 1.0;
+  const double mu = 0.3;
+  const PushedBall b = pushedBall(mu);
+  const Model& model = b.s.model;
+  const ConstraintList& c = b.s.constraints;
   SimulatorOptions so;
   so.scheme = ContactScheme::TimeStepping;
   for (int which = 0; which < 3; ++which) {
     Simulator sim(model, c, solverNumber(which, model, c), IntegratorType::RK4, {}, so);
-    sim.setJointForces([&](double t, const VecX& qq, const VecX&, VecX& tau) {
-      const double F = t > 0.2 ? k * (t - 0.2) : 0.0;
-      tau.tail<3>() = scenes::floatingRotation(qq, 0).transpose() * Vec3(F, 0, 0);
-    });
-    ASSERT_TRUE(sim.setState(0, q, v));
+    push(sim);
+    ASSERT_TRUE(sim.setState(0, b.q, b.v));
     long allocations = 0, sliding_steps = 0, sticking_steps = 0;
-    const double t_end = 0.2 + 3.5 * mu * kBallMass * 9.81 / k + 0.1;
+    const double t_end = kPushStart + 3.5 * mu * kBallMass * 9.81 / kPushRate + 0.1;
     while (sim.time() < t_end) {
       StepStatus st;
       {
