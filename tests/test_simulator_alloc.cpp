@@ -5,8 +5,10 @@
 #include <appell/appell_maggi.hpp>
 #include <appell/contacts.hpp>
 #include <appell/kkt.hpp>
+#include <appell/run.hpp>
 #include <appell/simulator.hpp>
 #include <appell/terrain.hpp>
+#include <appell/urdf.hpp>
 
 #include "scene.hpp"
 #include "test_solver_rows.hpp"
@@ -387,6 +389,45 @@ TEST(SimulatorAllocation, TimeSteppingStepsDoNotAllocate) {
     EXPECT_GT(sticking_steps, 100) << "solver " << which;
     EXPECT_EQ(allocations, 0) << "solver " << which;
   }
+}
+
+// Servos in time-stepping (timestepping/implicit_servos.cpp) allocate
+// nothing either: a ball on a vertical slider dropped onto the floor, its
+// servo pressing it down past its effort limit and then releasing it — the
+// servo alone in flight, with the contact after touchdown, at and off its
+// limit.
+TEST(SimulatorAllocation, TimeSteppingServosDoNotAllocate) {
+  const Scene s = loadSceneFromString(R"(<robot name="press"><link name="world"/>
+<link name="ball"><inertial><mass value="1"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial>
+<collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+<joint name="z" type="prismatic"><parent link="world"/><child link="ball"/><axis xyz="0 0 1"/>
+<limit lower="-1" upper="1" effort="30" velocity="100"/></joint>
+<appell>
+  <support name="floor" type="plane" normal="0 0 1" offset="0"/>
+  <contact name="foot" link="ball" kind="sliding" support="floor"/>
+  <initial><joint name="z" position="0.08"/></initial>
+  <actuator name="press" joint="z" type="position" kp="10000" kv="20">
+    <setpoint t="0" value="0.04"/><setpoint t="0.3" value="0.04"/><setpoint t="0.31" value="0.2"/>
+  </actuator>
+</appell></robot>)",
+                                      ".", "press.urdf");
+  RunOptions o;
+  o.contacts = ContactScheme::TimeStepping;
+  const auto sim = makeSimulator(s, o);
+  long allocations = 0, closed_steps = 0;
+  while (sim->time() < 0.5) {
+    StepStatus st;
+    {
+      Arm arm;
+      st = sim->step(1e-3);
+      allocations += g_allocations;
+    }
+    ASSERT_TRUE(st.ok) << st.message;
+    closed_steps += sim->isClosed(0);
+  }
+  EXPECT_GT(closed_steps, 100);
+  EXPECT_LT(closed_steps, 450) << "lifted off when the set-point rose";
+  EXPECT_EQ(allocations, 0);
 }
 
 // Changes of terrain piece allocate nothing (contact_features.cpp): a ball

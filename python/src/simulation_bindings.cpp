@@ -75,6 +75,9 @@ StepStatus stepping(PySimulation& s, bool check, F&& f) {
 void setJointForces(PySimulation& s, py::object tau) {
   Simulation::Guard guard(s);
   const int nv = s.scene().model.nv;
+  // The forces given replace all the scene's, its servos' too (as before
+  // servos were the simulator's own).
+  s.simulator().setActuators({});
   if (tau.is_none()) {
     s.simulator().setJointForces({});
   } else if (PyCallable_Check(tau.ptr())) {
@@ -240,7 +243,8 @@ void bindSimulation(py::module_& m) {
       }, "check"_a = true, "Projects the state onto the constraints (positions, then velocities).")
       .def("set_joint_forces", &setJointForces, "tau"_a,
            "None (no forces), a constant array of nv, or a callable tau(t, q, v) -> array of nv "
-           "(called with the GIL held: it serialises threads).")
+           "(called with the GIL held: it serialises threads); replaces the scene's efforts and "
+           "servos.")
       // Stepping.
       .def("step", [](PySimulation& s, std::optional<double> h, bool check) {
         return stepping(s, check, [&] { return s.step(h); });

@@ -131,7 +131,8 @@ std::unique_ptr<Simulator> makeSimulator(const Scene& scene, const RunOptions& o
       scene.model, scene.constraints,
       makeSolver(options.formulation, scene.model, scene.constraints), options.integrator, iopt,
       sopt);
-  if (auto forces = scene.jointForces()) sim->setJointForces(std::move(forces));
+  if (auto forces = scene.constantJointForces()) sim->setJointForces(std::move(forces));
+  if (!scene.actuators.empty()) sim->setActuators(scene.actuators);
   sim->setState(0.0, scene.q0, scene.v0);  // after the forces: the t = 0 reactions include them
   return sim;
 }

@@ -17,6 +17,7 @@
 // joint-force callback that do not allocate).
 #pragma once
 
+#include <appell/actuators.hpp>
 #include <appell/integrators.hpp>
 #include <appell/simulator_options.hpp>
 
@@ -50,6 +51,12 @@ class Simulator {
   /// Projects the current state onto the constraints (e.g. initial conditions).
   StepStatus projectState();
   void setJointForces(JointForces tau);
+  /// Servos (actuators.hpp) whose forces add to setJointForces' (throws
+  /// std::invalid_argument naming an invalid one). Between events they are
+  /// joint forces like any other; a Moreau–Jean step takes them implicitly,
+  /// at the step's end and within their effort limits, so a stiff servo on a
+  /// light link does not destabilize a 1 ms step (docs/contacts.md §10).
+  void setActuators(std::vector<Actuator> actuators);
 
   /// One step of size h (the first attempt, for adaptive integrators).
   StepStatus step(double h);

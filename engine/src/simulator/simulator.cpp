@@ -136,7 +136,31 @@ bool Simulator::Impl::decideContactModes(std::string& error) {
 }
 
 void Simulator::Impl::setJointForces(JointForces tau) {
-  tau_fn_ = std::move(tau);
+  user_tau_fn_ = std::move(tau);
+  composeJointForces();
+}
+
+void Simulator::Impl::setActuators(std::vector<Actuator> actuators) {
+  for (const Actuator& a : actuators) a.validate(model_);
+  actuators_ = std::move(actuators);
+  // The time-stepping stage is sized for its servos: rebuilt (an open
+  // window goes on with the new ones, from a cold start).
+  const bool had_stage = mj_ != nullptr;
+  mj_.reset();
+  if (had_stage) timeSteppingStage();
+  composeJointForces();
+}
+
+void Simulator::Impl::composeJointForces() {
+  if (actuators_.empty()) {
+    tau_fn_ = user_tau_fn_;
+  } else {
+    tau_fn_ = [this](double t, const VecX& q, const VecX& v, VecX& tau) {
+      tau.setZero();
+      if (user_tau_fn_) user_tau_fn_(t, q, v, tau);
+      if (tau.size() == model_.nv) applyActuators(model_, actuators_, t, q, v, tau);
+    };
+  }
   integrator_->reset();  // a carried stage holds the old forces' acceleration
 }
 

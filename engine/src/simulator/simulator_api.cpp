@@ -17,6 +17,9 @@ Simulator::~Simulator() = default;
 bool Simulator::setState(double t, const VecX& q, const VecX& v) { return impl_->setState(t, q, v); }
 StepStatus Simulator::projectState() { return impl_->projectState(); }
 void Simulator::setJointForces(JointForces tau) { impl_->setJointForces(std::move(tau)); }
+void Simulator::setActuators(std::vector<Actuator> actuators) {
+  impl_->setActuators(std::move(actuators));
+}
 StepStatus Simulator::step(double h) { return impl_->step(h); }
 bool Simulator::openTimeSteppingWindow(const std::string& why) {
   return impl_->openTimeSteppingWindow(why);

@@ -47,6 +47,8 @@ struct Simulator::Impl {
   bool setState(double t, const VecX& q, const VecX& v);
   StepStatus projectState();
   void setJointForces(JointForces tau);
+  void setActuators(std::vector<Actuator> actuators);
+  void composeJointForces();
   StepStatus step(double h);
   const ContactFrame& contactFrame(int constraint) const;
   bool openTimeSteppingWindow(const std::string& why);
@@ -182,6 +184,10 @@ struct Simulator::Impl {
   std::unique_ptr<ConstraintData> cdata_;
   std::unique_ptr<PositionProjector> projector_;
   std::unique_ptr<Field> field_;
+  // The joint forces: the caller's, the servos', and their sum, which every
+  // event stage evaluates (a Moreau–Jean step takes the servos implicitly).
+  JointForces user_tau_fn_;
+  std::vector<Actuator> actuators_;
   JointForces tau_fn_;
 
   double t_ = 0, t_prev_ = 0;

@@ -86,7 +86,8 @@ void timestepping::checkOptions(const TimeSteppingOptions& o) {
 bool Simulator::Impl::timeSteppingStage() {
   if (mj_ || !uni_) return mj_ != nullptr;
   try {
-    mj_ = std::make_unique<timestepping::MoreauJean>(model_, constraints_, options_.timestepping,
+    mj_ = std::make_unique<timestepping::MoreauJean>(model_, constraints_, actuators_,
+                                                     options_.timestepping,
                                                      options_.contacts.gap_tol);
   } catch (const std::bad_alloc&) {
     return false;  // too large to time-step: the events keep the scene (and report their failure)
@@ -270,7 +271,7 @@ StepStatus Simulator::Impl::timeSteppingStep(double h) {
     events_.push_back(e);
     window_contact_ = -1;
   }
-  if (!mj_->step(model_, *data_, constraints_, *cdata_, *solver_, tau_fn_, t_, q_, v_, hs,
+  if (!mj_->step(model_, *data_, constraints_, *cdata_, *solver_, user_tau_fn_, t_, q_, v_, hs,
                  options_.contacts.rest_speed)) {
     // At a window's first step the events' own reason comes first.
     const bool opening = options_.scheme == ContactScheme::Auto && t_ == window_start_;

@@ -134,10 +134,11 @@ struct Delassus {
   /// R's columns for the problem rows `map` (indices into J) and W = J R:
   /// one solve of `solver` per row at τ + s Jᵢᵀ, less the free one (v̇₀),
   /// over s (the map is affine in τ). false with `error` when a solve fails.
+  /// with_W false: R's columns only.
   bool respond(const Model& model, Data& data, const ConstraintList& constraints,
                ConstraintData& cdata, ConstrainedSolver& solver, const VecX& q, const VecX& v,
                const VecX& tau, const VecX& vdot0, const std::vector<int>& map, int n,
-               ConstrainedResult& res, MatX& W, std::string& error);
+               ConstrainedResult& res, MatX& W, std::string& error, bool with_W = true);
 };
 
 }  // namespace appell::timestepping

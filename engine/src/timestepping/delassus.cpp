@@ -41,7 +41,7 @@ bool Delassus::respond(const Model& model, Data& data, const ConstraintList& con
                        ConstraintData& cdata, ConstrainedSolver& solver, const VecX& q,
                        const VecX& v, const VecX& tau0, const VecX& vdot0,
                        const std::vector<int>& map, int n, ConstrainedResult& res, MatX& W,
-                       std::string& error) {
+                       std::string& error, bool with_W) {
   // At the scale of the forces (any scale is exact up to round-off relative
   // to τ; the weight and τ set that round-off).
   const double s = std::max({1.0, tau0.lpNorm<Eigen::Infinity>(),
@@ -56,6 +56,7 @@ bool Delassus::respond(const Model& model, Data& data, const ConstraintList& con
     }
     R.col(i) = (res.vdot - vdot0) / s;
   }
+  if (!with_W) return true;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) W(i, j) = J.row(map[i]).dot(R.col(j));
   // Symmetric in exact arithmetic: remove the round-off's skew part.

@@ -22,7 +22,8 @@ int rowList(const Candidate& k, int* out) {
 }  // namespace
 
 MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
-                       const TimeSteppingOptions& options, double gap_tol)
+                       std::vector<Actuator> servos, const TimeSteppingOptions& options,
+                       double gap_tol)
     : options_(options), gap_tol_(gap_tol) {
   int rows = 0;
   for (int c = 0; c < static_cast<int>(constraints.size()); ++c) {
@@ -54,8 +55,17 @@ MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
   slid_.assign(all_.size(), 0);
   restituted_.assign(all_.size(), 0);
   problem_.reserve(rows, static_cast<int>(all_.size()));
-  delassus_.reserve(model.nv, rows);
-  map_.reserve(rows);
+  servos_ = ImplicitServos(model, std::move(servos), rows);
+  const int ns = servos_.size();
+  // The servo rows follow the contacts' in J: the coordinate itself, u = v_d.
+  delassus_.reserve(model.nv, rows + ns);
+  for (int i = 0; i < ns; ++i) delassus_.J(rows + i, servos_.dof(i)) = 1;
+  map_.reserve(rows + ns);
+  if (ns > 0) W_all_ = MatX::Zero(rows + ns, rows + ns);
+  Rs_ = MatX::Zero(model.nv, ns);
+  Wss_ = MatX::Zero(ns, ns);
+  u_servo_ = VecX::Zero(ns);
+  vfree0_ = VecX::Zero(model.nv);
   rows_ = rows;
   qnext_ = VecX::Zero(model.nq);
   uminus_ = ufree_ = VecX::Zero(std::max(rows, 1));
@@ -140,9 +150,14 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
                       double rest_speed) {
   error_.clear();
   work_ = {};
+  servos_settled_ = true;
   for (int k = 0; k < static_cast<int>(all_.size()); ++k)
     slid_[k] = cdata.isSliding(all_[k].c) ? 1 : 0;  // (the last step's mode, either scheme's)
   if (!freeVelocity(model, data, constraints, cdata, solver, tau_fn, t, q, v, h)) return false;
+  if (!servos_.empty()) {
+    servos_.law(model, t, q, v, h, options_.theta);
+    if (!servosAlone(model, data, constraints, cdata, solver, q, v)) return false;
+  }
   // The contacts at the predicted end q̃ = q ⊕ h v_free (θ = 1): a floating
   // body's body-frame velocity is measured in its frame at the step's end
   // (at q, the frame's turn h ω would enter the normal velocity as a
@@ -176,35 +191,116 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
       return false;
     }
   const int n = problem_.n;
-  if (n > 0) {
-    // The Delassus operator at q̃, over the bilateral rows there.
-    for (const Candidate& k : all_) cdata.setActive(k.c, false);
-    evaluateConstraintRows(model, data, constraints, cdata, t + h, qnext_, vfree_);
-    solver.solve(model, data, constraints, cdata, qnext_, vfree_, tau_, res2_,
-                 SolveOutputs::Accelerations);
-    if (!res2_.ok) {
-      error_ = "the Delassus operator's solve failed: " + res2_.error;
-      return false;
-    }
-    vdot_ = res2_.vdot;
-    if (!delassus_.respond(model, data, constraints, cdata, solver, qnext_, vfree_, tau_, vdot_,
-                           map_, n, res2_, problem_.W, error_))
-      return false;
-    problem_.solve(options_.residual_tol, options_.max_sweeps);
-  } else {
-    problem_.sweeps = 0;
-    problem_.residual = 0;
-    problem_.converged = true;
-  }
-  // v⁺ = v_free + R P.
+  if (!solveContacts(model, data, constraints, cdata, solver, t + h, n)) return false;
   v0_ = v;  // (v at the step's start, for the work and the positions)
-  v = vfree_;
-  if (n > 0) v.noalias() += delassus_.R.leftCols(n) * problem_.P.head(n);
+  endVelocity(n, v);
   finish(cdata, v0_, v, h);
+  for (int i = 0; i < servos_.size(); ++i) {
+    const int d = servos_.dof(i);
+    work_.joint += 0.5 * servos_.P()[i] * (v0_[d] + v[d]);
+  }
   // q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v).
   vfree_ = options_.theta * v + (1 - options_.theta) * v0_;
   integrate(model, q, vfree_, h, qnext_);
   q.swap(qnext_);
+  return true;
+}
+
+// The contact problem of the step's n candidate rows at q̃ (with the
+// servos when there are any); none: nothing to solve.
+bool MoreauJean::solveContacts(const Model& model, Data& data, const ConstraintList& constraints,
+                               ConstraintData& cdata, ConstrainedSolver& solver, double t_end,
+                               int n) {
+  if (n == 0) {
+    problem_.sweeps = 0;
+    problem_.residual = 0;
+    problem_.converged = true;
+    return true;
+  }
+  // The Delassus operator at q̃, over the bilateral rows there.
+  for (const Candidate& k : all_) cdata.setActive(k.c, false);
+  evaluateConstraintRows(model, data, constraints, cdata, t_end, qnext_, vfree_);
+  solver.solve(model, data, constraints, cdata, qnext_, vfree_, tau_, res2_,
+               SolveOutputs::Accelerations);
+  if (!res2_.ok) {
+    error_ = "the Delassus operator's solve failed: " + res2_.error;
+    return false;
+  }
+  vdot_ = res2_.vdot;
+  if (!servos_.empty()) return solveWithServos(model, data, constraints, cdata, solver, n);
+  if (!delassus_.respond(model, data, constraints, cdata, solver, qnext_, vfree_, tau_, vdot_,
+                         map_, n, res2_, problem_.W, error_))
+    return false;
+  problem_.solve(options_.residual_tol, options_.max_sweeps);
+  return true;
+}
+
+// v⁺ = v_free + R P over the n problem rows; with servos and contacts,
+// v_free without the servos + R_c P_c + R_s P_s (R_c at q̃, R_s at q); with servos and
+// no contact, v_free already holds the servos' impulses (servosAlone).
+void MoreauJean::endVelocity(int n, VecX& v) const {
+  if (n > 0 && !servos_.empty()) {
+    v = vfree0_;
+    v.noalias() += delassus_.R.leftCols(n) * problem_.P.head(n);
+    v.noalias() += Rs_ * servos_.P();
+  } else {
+    v = vfree_;
+    if (n > 0) v.noalias() += delassus_.R.leftCols(n) * problem_.P.head(n);
+  }
+}
+
+// The servos over the step without contacts, at q: their responses R_s
+// (Delassus::respond on the servo rows), their impulses, and v_free with
+// them — the velocity that predicts q̃ (and the step's end in flight).
+bool MoreauJean::servosAlone(const Model& model, Data& data, const ConstraintList& constraints,
+                             ConstraintData& cdata, ConstrainedSolver& solver, const VecX& q,
+                             const VecX& v) {
+  const int ns = servos_.size();
+  map_.clear();
+  for (int i = 0; i < ns; ++i) map_.push_back(rows_ + i);
+  if (!delassus_.respond(model, data, constraints, cdata, solver, q, v, tau_, vdot_, map_, ns,
+                         res2_, W_all_, error_, false))
+    return false;
+  Rs_ = delassus_.R.leftCols(ns);
+  // Wₛₛ = e_dᵀ Rₛ, symmetric up to round-off.
+  for (int i = 0; i < ns; ++i)
+    for (int j = 0; j <= i; ++j)
+      Wss_(i, j) = Wss_(j, i) = 0.5 * (Rs_(servos_.dof(i), j) + Rs_(servos_.dof(j), i));
+  vfree0_ = vfree_;
+  for (int i = 0; i < ns; ++i) u_servo_[i] = vfree_[servos_.dof(i)];
+  servos_settled_ = servos_.solveAlone(Wss_, u_servo_);
+  vfree_.noalias() += Rs_ * servos_.P();
+  return true;
+}
+
+// The contact problem with the servos eliminated (implicit_servos.hpp): the
+// responses of the n problem rows at q̃, the servos' from servosAlone, the
+// contacts' Schur complement, solved again while the set of servos at their effort
+// limits changes (each pass warm-started from the last).
+bool MoreauJean::solveWithServos(const Model& model, Data& data, const ConstraintList& constraints,
+                                 ConstraintData& cdata, ConstrainedSolver& solver, int n) {
+  const int ns = servos_.size();
+  if (!delassus_.respond(model, data, constraints, cdata, solver, qnext_, vfree_, tau_, vdot_,
+                         map_, n, res2_, W_all_, error_))
+    return false;
+  // The servos' columns from their responses at q (servosAlone): W_cs = J_c Rₛ
+  // and its transpose, W_ss as there — one solve per servo a step, not two;
+  // the operator at q instead of q̃ is a first-order difference, as the
+  // scheme's own.
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < ns; ++j)
+      W_all_(i, n + j) = W_all_(n + j, i) = delassus_.J.row(map_[i]).dot(Rs_.col(j));
+  W_all_.block(n, n, ns, ns) = Wss_;
+  for (int i = 0; i < ns; ++i) u_servo_[i] = vfree0_[servos_.dof(i)];
+  bool settled = false;
+  for (int pass = 0; pass <= 2 * ns + 4 && !settled; ++pass) {
+    for (int i = 0; i < n; ++i)
+      problem_.u_free[i] = delassus_.J.row(map_[i]).dot(vfree0_) + delassus_.b[map_[i]];
+    servos_.eliminate(W_all_, n, u_servo_, problem_.W, problem_.u_free);
+    problem_.solve(options_.residual_tol, options_.max_sweeps);
+    settled = servos_.impulses(W_all_, n, problem_.P);
+  }
+  servos_settled_ = servos_settled_ && settled;
   return true;
 }
 

@@ -27,6 +27,7 @@
 #pragma once
 
 #include "timestepping/contact_problem.hpp"
+#include "timestepping/implicit_servos.hpp"
 
 #include <appell/simulator.hpp>
 
@@ -64,8 +65,10 @@ struct StepWork {
 
 class MoreauJean {
  public:
-  MoreauJean(const Model& model, const ConstraintList& constraints, const TimeSteppingOptions& options,
-             double gap_tol);
+  /// `servos` are taken implicitly (implicit_servos.hpp); the joint forces
+  /// given to step() exclude them.
+  MoreauJean(const Model& model, const ConstraintList& constraints,
+             std::vector<Actuator> servos, const TimeSteppingOptions& options, double gap_tol);
 
   /// One step from (t, q, v) over h: q, v become the end state (t + h is the
   /// caller's). `cdata`'s active flags are overwritten (the caller sets them
@@ -89,7 +92,7 @@ class MoreauJean {
   const VecX& vdot() const { return vdot_; }
   int sweeps() const { return problem_.sweeps; }
   double residual() const { return problem_.residual; }
-  bool converged() const { return problem_.converged; }
+  bool converged() const { return problem_.converged && servos_settled_; }
   bool polished() const { return problem_.polished; }
   /// Candidate contacts of the last step.
   int candidates() const { return static_cast<int>(active_.size()); }
@@ -100,6 +103,13 @@ class MoreauJean {
                     const Simulator::JointForces& tau_fn, double t, const VecX& q,
                     const VecX& v, double h);
   void selectCandidates(const ConstraintData& cdata, double h, double rest_speed);
+  bool solveContacts(const Model& model, Data& data, const ConstraintList& constraints,
+                     ConstraintData& cdata, ConstrainedSolver& solver, double t_end, int n);
+  void endVelocity(int n, VecX& v) const;
+  bool servosAlone(const Model& model, Data& data, const ConstraintList& constraints,
+                   ConstraintData& cdata, ConstrainedSolver& solver, const VecX& q, const VecX& v);
+  bool solveWithServos(const Model& model, Data& data, const ConstraintList& constraints,
+                       ConstraintData& cdata, ConstrainedSolver& solver, int n);
   void finish(const ConstraintData& cdata, const VecX& v0, const VecX& v1, double h);
 
   TimeSteppingOptions options_;
@@ -115,6 +125,11 @@ class MoreauJean {
   std::vector<int> map_;           ///< per problem row: its row in the Delassus J
   int rows_ = 0;                   ///< rows of every candidate (J's layout)
   ContactProblem problem_;
+  ImplicitServos servos_;
+  MatX W_all_;                     ///< the Delassus operator over problem and servo rows
+  MatX Rs_, Wss_;                  ///< the servos' responses and their block, at the step's q
+  VecX u_servo_, vfree0_;          ///< servo rows' and v's free velocity without the servos
+  bool servos_settled_ = true;     ///< the servos' limited set settled this step
   Delassus delassus_;
   VecX uminus_, ufree_;            ///< every candidate row at v and at v_free
   VecX tau_, vfree_, vdot_, lambda_, impulse_, v0_, qnext_;

@@ -144,6 +144,10 @@ struct Scene {
   /// scene declares none). The function reads this scene's model: the scene
   /// must outlive it, as it must outlive a Simulator made on it.
   Simulator::JointForces jointForces() const;
+  /// The constant efforts alone (empty when none): with
+  /// Simulator::setActuators(actuators), what makeSimulator gives a simulator,
+  /// so that its time-stepping takes the servos implicitly.
+  Simulator::JointForces constantJointForces() const;
   /// Whether any joint force is declared (a driven scene: energy is not conserved).
   bool driven() const;
 

@@ -51,6 +51,11 @@ Simulator::JointForces Scene::jointForces() const {
   };
 }
 
+Simulator::JointForces Scene::constantJointForces() const {
+  if (!(tau.size() > 0 && tau.size() == model.nv && tau.cwiseAbs().maxCoeff() > 0)) return {};
+  return [tau = tau](double, const VecX&, const VecX&, VecX& out) { out = tau; };
+}
+
 bool Scene::driven() const {
   return !actuators.empty() || (tau.size() && tau.cwiseAbs().maxCoeff() > 0);
 }
