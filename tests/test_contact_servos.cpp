@@ -1,9 +1,10 @@
 // Servos inside Moreau–Jean steps (timestepping/implicit_servos.hpp): taken
 // at the step's end, a stiff servo on a light body is the backward-Euler
 // spring of its closed-form recurrence, one at its effort limit pushes with
-// exactly h τ_max per step, and a servo pressing a body onto the floor is
-// balanced by the contact force its law demands — the same force as between
-// events — within its effort limit or at it.
+// exactly h τ_max per step, a soft one stays an explicit force, and a stiff
+// servo pressing a body onto the floor is balanced by the contact force its
+// law demands — the same force as between events — within its effort limit
+// or at it.
 #include <gtest/gtest.h>
 
 #include <appell/run.hpp>
@@ -92,6 +93,25 @@ TEST(ContactServos, StiffServoOnALightBodyIsTheBackwardEulerSpring) {
   EXPECT_NEAR(sim->q()[0], target, 1e-9) << "settled on its set-point";
 }
 
+// A soft servo (k_p = 10 N/m on 10 g: (ω h)² = 10⁻³) is left explicit by
+// the gate, as between events: its force at the step's start,
+// v⁺ = v + h (k_p (q* − q) − k_v v)/m, q⁺ = q + h v⁺ — no response solves.
+TEST(ContactServos, SoftServoStaysAnExplicitForce) {
+  const double m = 0.01, kp = 10, kv = 0.01, target = 0.1;
+  const Scene s = loadSceneFromString(
+      slider(R"(<actuator name="hold" joint="x" type="position" kp="10" kv="0.01" setpoint="0.1"/>)"),
+      ".", "slider.urdf");
+  auto sim = makeSimulator(s, scheme(ContactScheme::TimeStepping));
+  double q = 0, v = 0;
+  for (int k = 0; k < 300; ++k) {
+    ASSERT_TRUE(sim->step(kH).ok);
+    v += kH * (kp * (target - q) - kv * v) / m;
+    q += kH * v;
+    ASSERT_NEAR(sim->v()[0], v, 1e-12 * std::max(1.0, std::abs(v))) << "step " << k;
+    ASSERT_NEAR(sim->q()[0], q, 1e-13) << "step " << k;
+  }
+}
+
 // The same servo limited to 0.5 N and asked for a set-point 1 m away pushes
 // with P = h τ_max at every step: v_N = N h τ_max / m, q_N = h² τ_max/m ·
 // N(N+1)/2, and the work it did, Σ P (v + v⁺)/2, is exactly ½ m v_N².
@@ -110,13 +130,14 @@ TEST(ContactServos, ServoAtItsEffortLimitPushesWithExactlyItsLimit) {
   EXPECT_NEAR(sim->jointWork(), 0.5 * m * vN * vN, 1e-12 * m * vN * vN);
 }
 
-// A servo pressing a resting ball onto the floor: at rest its force is
+// A stiff servo pressing a resting ball onto the floor: at rest its force is
 // k_p (q* − q) = −k_p δ, so the floor carries m g + k_p δ — under the events
 // (an exact solve) and under time-stepping, where the servo and the contact
 // are one problem (the contact sees the servo's Schur complement). At an
 // effort limit below k_p δ the floor carries m g + τ_max.
 TEST(ContactServos, ServoPressingOnTheFloorIsBalancedByTheContact) {
-  const double g = 9.81, kp = 1e4, delta = 0.01;
+  // k_p = 10⁶ N/m on 1 kg, (ω h)² = 1: stiff, so implicit in time-stepping.
+  const double g = 9.81, kp = 1e6, delta = 1e-4;
   for (double effort : {1000.0, 30.0}) {
     SCOPED_TRACE("effort limit " + std::to_string(effort));
     const Scene s = loadSceneFromString(pressedBall(kp, delta, effort), ".", "press.urdf");

@@ -22,6 +22,14 @@
 // P = ±h τ_max; its D^½ is set to 0, which makes its row and column of S the
 // identity's — the set of limited servos is found by an active-set loop (a
 // box-constrained problem in the symmetric positive definite W + D⁻¹).
+// Only stiff servos need this: a servo whose ω h is small is as accurate
+// and cheaper explicit (no response solves). Every 100 steps (and at the
+// first) the stage computes every servo's mobility (M⁻¹)_dd (one solve
+// each) and takes implicitly the fewest servos, stiffest first, that leave
+// the others' Σ D_d (M⁻¹)_dd ≤ 0.1 — which bounds (ω h)² of every mode the
+// explicit ones make, since the largest eigenvalue of D^½ M⁻¹ D^½ is at most
+// its trace; the others are forces at the step's start, as between events
+// (a car's steering servo: explicit; iCub's neck: implicit).
 // With contacts, the servos are eliminated from the contact problem: for
 // contact rows c, Z = D^½ W_sc, the contacts see
 //     W_cc − Zᵀ S⁻¹ Z   (a Schur complement: symmetric, positive semidefinite)
@@ -51,6 +59,16 @@ class ImplicitServos {
   /// The law over [t, t + h] at (q, v): a, D and the impulse bound; every
   /// servo starts unlimited unless it was limited at the last step.
   void law(const Model& model, double t, const VecX& q, const VecX& v, double h, double theta);
+  /// Whether this step re-chooses the implicit servos (then call gate()).
+  bool gateDue() const { return gate_age_ < 0 || gate_age_ >= kGateSteps; }
+  /// Chooses the implicit servos from their mobilities (M⁻¹)_dd (after law()).
+  void gate(const VecX& mobility);
+  /// Counts a step since the last gate.
+  void age() { ++gate_age_; }
+  bool isImplicit(int i) const { return implicit_[i] != 0; }
+  bool anyImplicit() const { return implicit_count_ > 0; }
+  /// τ += the explicit servos' forces at (t, q, v).
+  void addExplicit(const Model& model, double t, const VecX& q, const VecX& v, VecX& tau) const;
 
   /// The servos alone: P from their block W (size × size) and their free
   /// velocities; the limited set found by the active-set loop. false when it
@@ -74,7 +92,12 @@ class ImplicitServos {
 
   std::vector<Actuator> servos_;
   std::vector<int> dof_;
+  static constexpr int kGateSteps = 100;
+  static constexpr double kExplicitBound = 0.1;  ///< Σ D_d (M⁻¹)_dd of the explicit servos
   std::vector<signed char> limited_;  ///< −1, 0, +1: at −h τ_max, free, at +h τ_max
+  std::vector<char> implicit_;        ///< per servo: taken implicitly (else explicit, P = 0)
+  int implicit_count_ = 0;
+  int gate_age_ = -1;
   VecX a_, D_, bound_, dsq_, P_, rhs_, y_, u_s_, P0_;
   MatX S_, Z_, SZ_;
   Eigen::LLT<MatX> llt_;

@@ -63,6 +63,7 @@ MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
   map_.reserve(rows + ns);
   if (ns > 0) W_all_ = MatX::Zero(rows + ns, rows + ns);
   Rs_ = MatX::Zero(model.nv, ns);
+  mobility_ = VecX::Zero(ns);
   Wss_ = MatX::Zero(ns, ns);
   u_servo_ = VecX::Zero(ns);
   vfree0_ = VecX::Zero(model.nv);
@@ -92,6 +93,7 @@ bool MoreauJean::freeVelocity(const Model& model, Data& data, const ConstraintLi
       return false;
     }
   }
+  servos_.addExplicit(model, t, q, v, tau_);
   solver.solve(model, data, constraints, cdata, q, v, tau_, res_, SolveOutputs::All);
   if (!res_.ok || !res_.vdot.allFinite()) {
     error_ = "the free motion's solve failed: " + (res_.ok ? std::string("non-finite v̇") : res_.error);
@@ -153,11 +155,15 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
   servos_settled_ = true;
   for (int k = 0; k < static_cast<int>(all_.size()); ++k)
     slid_[k] = cdata.isSliding(all_[k].c) ? 1 : 0;  // (the last step's mode, either scheme's)
-  if (!freeVelocity(model, data, constraints, cdata, solver, tau_fn, t, q, v, h)) return false;
   if (!servos_.empty()) {
     servos_.law(model, t, q, v, h, options_.theta);
-    if (!servosAlone(model, data, constraints, cdata, solver, q, v)) return false;
+    if (servos_.gateDue() && !gateServos(model, data, constraints, cdata, solver, t, q, v))
+      return false;
+    servos_.age();
   }
+  if (!freeVelocity(model, data, constraints, cdata, solver, tau_fn, t, q, v, h)) return false;
+  if (servos_.anyImplicit() && !servosAlone(model, data, constraints, cdata, solver, q, v))
+    return false;
   // The contacts at the predicted end q̃ = q ⊕ h v_free (θ = 1): a floating
   // body's body-frame velocity is measured in its frame at the step's end
   // (at q, the frame's turn h ω would enter the normal velocity as a
@@ -196,6 +202,7 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
   endVelocity(n, v);
   finish(cdata, v0_, v, h);
   for (int i = 0; i < servos_.size(); ++i) {
+    if (!servos_.isImplicit(i)) continue;  // (an explicit servo's work is in τ's)
     const int d = servos_.dof(i);
     work_.joint += 0.5 * servos_.P()[i] * (v0_[d] + v[d]);
   }
@@ -227,7 +234,7 @@ bool MoreauJean::solveContacts(const Model& model, Data& data, const ConstraintL
     return false;
   }
   vdot_ = res2_.vdot;
-  if (!servos_.empty()) return solveWithServos(model, data, constraints, cdata, solver, n);
+  if (servos_.anyImplicit()) return solveWithServos(model, data, constraints, cdata, solver, n);
   if (!delassus_.respond(model, data, constraints, cdata, solver, qnext_, vfree_, tau_, vdot_,
                          map_, n, res2_, problem_.W, error_))
     return false;
@@ -239,7 +246,7 @@ bool MoreauJean::solveContacts(const Model& model, Data& data, const ConstraintL
 // v_free without the servos + R_c P_c + R_s P_s (R_c at q̃, R_s at q); with servos and
 // no contact, v_free already holds the servos' impulses (servosAlone).
 void MoreauJean::endVelocity(int n, VecX& v) const {
-  if (n > 0 && !servos_.empty()) {
+  if (n > 0 && servos_.anyImplicit()) {
     v = vfree0_;
     v.noalias() += delassus_.R.leftCols(n) * problem_.P.head(n);
     v.noalias() += Rs_ * servos_.P();
@@ -247,6 +254,32 @@ void MoreauJean::endVelocity(int n, VecX& v) const {
     v = vfree_;
     if (n > 0) v.noalias() += delassus_.R.leftCols(n) * problem_.P.head(n);
   }
+}
+
+// The gate (implicit_servos.hpp): every servo's mobility (M⁻¹)_dd under the
+// bilateral rows at (t, q, v), one solve each — its response to a unit force
+// on its own coordinate — and the choice of the implicit ones.
+bool MoreauJean::gateServos(const Model& model, Data& data, const ConstraintList& constraints,
+                            ConstraintData& cdata, ConstrainedSolver& solver, double t,
+                            const VecX& q, const VecX& v) {
+  for (const Candidate& k : all_) cdata.setActive(k.c, false);
+  evaluateConstraintRows(model, data, constraints, cdata, t, q, v);
+  tau_.setZero();  // (any τ: the response is affine in it)
+  solver.solve(model, data, constraints, cdata, q, v, tau_, res2_, SolveOutputs::Accelerations);
+  if (!res2_.ok) {
+    error_ = "the servos' mobility solve failed: " + res2_.error;
+    return false;
+  }
+  vdot_ = res2_.vdot;
+  const int ns = servos_.size();
+  map_.clear();
+  for (int i = 0; i < ns; ++i) map_.push_back(rows_ + i);
+  if (!delassus_.respond(model, data, constraints, cdata, solver, q, v, tau_, vdot_, map_, ns,
+                         res2_, W_all_, error_, false))
+    return false;
+  for (int i = 0; i < ns; ++i) mobility_[i] = delassus_.R(servos_.dof(i), i);
+  servos_.gate(mobility_);
+  return true;
 }
 
 // The servos over the step without contacts, at q: their responses R_s
@@ -257,11 +290,15 @@ bool MoreauJean::servosAlone(const Model& model, Data& data, const ConstraintLis
                              const VecX& v) {
   const int ns = servos_.size();
   map_.clear();
-  for (int i = 0; i < ns; ++i) map_.push_back(rows_ + i);
-  if (!delassus_.respond(model, data, constraints, cdata, solver, q, v, tau_, vdot_, map_, ns,
-                         res2_, W_all_, error_, false))
+  for (int i = 0; i < ns; ++i)
+    if (servos_.isImplicit(i)) map_.push_back(rows_ + i);
+  if (!delassus_.respond(model, data, constraints, cdata, solver, q, v, tau_, vdot_, map_,
+                         static_cast<int>(map_.size()), res2_, W_all_, error_, false))
     return false;
-  Rs_ = delassus_.R.leftCols(ns);
+  for (int i = 0, j = 0; i < ns; ++i) {
+    if (servos_.isImplicit(i)) Rs_.col(i) = delassus_.R.col(j++);
+    else Rs_.col(i).setZero();  // (explicit: its force is in τ)
+  }
   // Wₛₛ = e_dᵀ Rₛ, symmetric up to round-off.
   for (int i = 0; i < ns; ++i)
     for (int j = 0; j <= i; ++j)

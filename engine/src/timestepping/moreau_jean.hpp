@@ -106,6 +106,9 @@ class MoreauJean {
   bool solveContacts(const Model& model, Data& data, const ConstraintList& constraints,
                      ConstraintData& cdata, ConstrainedSolver& solver, double t_end, int n);
   void endVelocity(int n, VecX& v) const;
+  bool gateServos(const Model& model, Data& data, const ConstraintList& constraints,
+                  ConstraintData& cdata, ConstrainedSolver& solver, double t, const VecX& q,
+                  const VecX& v);
   bool servosAlone(const Model& model, Data& data, const ConstraintList& constraints,
                    ConstraintData& cdata, ConstrainedSolver& solver, const VecX& q, const VecX& v);
   bool solveWithServos(const Model& model, Data& data, const ConstraintList& constraints,
@@ -128,6 +131,7 @@ class MoreauJean {
   ImplicitServos servos_;
   MatX W_all_;                     ///< the Delassus operator over problem and servo rows
   MatX Rs_, Wss_;                  ///< the servos' responses and their block, at the step's q
+  VecX mobility_;                  ///< per servo: (M⁻¹)_dd under the bilateral rows, for the gate
   VecX u_servo_, vfree0_;          ///< servo rows' and v's free velocity without the servos
   bool servos_settled_ = true;     ///< the servos' limited set settled this step
   Delassus delassus_;
