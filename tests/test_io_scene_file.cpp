@@ -317,3 +317,29 @@ TEST(SceneFile, ExampleRobotDataScenesLoadWhenRosPackagePathFindsThem) {
       EXPECT_FALSE(sim->isClosed(c)) << s.contacts[c]->name() << " starts closed: not above the floor";
   }
 }
+
+// Protects issue 43's "falls onto a plane for 1 s" on the descriptions as
+// published (run only where ROS_PACKAGE_PATH finds example-robot-data, as
+// above): each scene of examples/published_robots runs its second with its
+// own settings — landing, standing, time-stepping windows where the events
+// give up — to its end, its work balance within the time-stepping's O(h)
+// (2e-2 relative; the event-only runs close to 1e-6), and iCub stands (its
+// bounded neck and servos were a divergence in its window until the servos
+// became implicit there).
+TEST(SceneFile, ExampleRobotDataScenesFallOntoTheFloorForOneSecond) {
+  if (findPackage("example-robot-data").empty())
+    GTEST_SKIP() << "ROS_PACKAGE_PATH does not hold example-robot-data";
+  const std::string dir = std::string(APPELL_SOURCE_DIR) + "/examples/published_robots/";
+  for (const char* name : {"anymal", "solo", "solo12", "tiago", "tiago_no_hand", "tiago_dual",
+                           "icub_reduced", "icub"}) {
+    SCOPED_TRACE(name);
+    const Scene s = loadScene(dir + name + ".xml");
+    double root_height = 0;  // (the floating root's z: q[2])
+    const RunSummary r =
+        runScene(s, runOptions(s.settings), [&](const Simulator& sim) { root_height = sim.q()[2]; });
+    ASSERT_TRUE(r.ok) << r.failure;
+    EXPECT_NEAR(r.time, 1.0, 1e-12);
+    EXPECT_LT(r.relativeEnergyDeviation(), r.counters.timestepping_steps > 0 ? 2e-2 : 1e-6);
+    if (std::string(name) == "icub") EXPECT_GT(root_height, 0.55) << "standing, not fallen";
+  }
+}
