@@ -85,6 +85,11 @@ struct ContactSpec {
   bool unilateral = true;
   /// Newton's coefficient of restitution of its impacts, in [0, 1] (0: plastic).
   double restitution = 0;
+  /// A compliant normal (ContactLaw::normal_stiffness, normal_damping): k > 0
+  /// N/m and c ≥ 0 N·s/m; 0: rigid. Compliant contacts are time-stepped
+  /// (docs/contacts.md §10); they take no restitution (c dissipates).
+  double normal_stiffness = 0;
+  double normal_damping = 0;
   /// How many places a smooth body may touch a terrain at once, 1 … 4 (a
   /// ball in a valley touches both slopes; a tyre in a pothole its rim): one
   /// unilateral contact per point (makeContactPoints), each on its own piece

@@ -108,6 +108,15 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
     fail("a creep speed needs a finite friction coefficient μ > 0 (the force it saturates at)");
   if (spec_.creep_speed > 0 && !spec_.unilateral)
     fail("a creep speed needs a unilateral contact (friction acts on unilateral contacts)");
+  if (!(spec_.normal_stiffness >= 0 && std::isfinite(spec_.normal_stiffness)) ||
+      !(spec_.normal_damping >= 0 && std::isfinite(spec_.normal_damping)))
+    fail("the normal stiffness and damping must be ≥ 0 and finite (N/m, N·s/m; 0: rigid)");
+  if (spec_.normal_damping > 0 && !(spec_.normal_stiffness > 0))
+    fail("a normal damping needs a normal stiffness > 0 (a damper alone does not hold the contact)");
+  if (spec_.normal_stiffness > 0 && !spec_.unilateral)
+    fail("a compliant normal needs a unilateral contact");
+  if (spec_.normal_stiffness > 0 && spec_.restitution > 0)
+    fail("a compliant contact takes no restitution: its normal damping sets what an impact keeps");
   try {
     validateShape(shape);
     validateSupport(support);
@@ -119,6 +128,8 @@ ShapeContact::ShapeContact(ContactSpec spec) : spec_(std::move(spec)), rows_(row
   law_.spin = spec_.mu_spin;
   law_.creep_speed = spec_.creep_speed;
   law_.restitution = spec_.restitution;
+  law_.normal_stiffness = spec_.normal_stiffness;
+  law_.normal_damping = spec_.normal_damping;
   if (auto* p = std::get_if<Plane>(&support.surface)) p->normal.normalize();
   // Face normals, adjacency and FCL's hierarchy, once (evaluation must not allocate).
   if (auto* t = std::get_if<TerrainMesh>(&support.surface); t && !t->index)

@@ -133,7 +133,13 @@ struct ContactLaw {
   /// Newton's coefficient of restitution on the unilateral row at an impact
   /// (0: plastic).
   double restitution = 0;
-  // (A compliant contact's stiffness and damping will be fields here.)
+  /// A compliant normal (a tyre's or a sole's): stiffness k > 0 (N/m) and
+  /// damping c ≥ 0 (N·s/m) of a Kelvin–Voigt element, λₙ = max(0, −k g − c ġ)
+  /// at the gap g — taken at the end of each time-stepping step
+  /// (timestepping/moreau_jean.cpp). 0: rigid (g ≥ 0 exactly).
+  double normal_stiffness = 0;
+  double normal_damping = 0;
+  bool compliant() const { return normal_stiffness > 0; }
 };
 
 class Constraint {

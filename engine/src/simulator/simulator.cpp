@@ -22,6 +22,7 @@ Simulator::Impl::Impl(const Model& model, ConstraintList constraints,
   for (const auto& c : constraints_)
     if (!c) throw std::invalid_argument("Simulator: the constraint list holds a null constraint");
   validateOptions(options_);
+  chooseSchemeForCompliance();
   data_ = std::make_unique<Data>(
       model_, solver_->usesDenseRows() ? MassMatrix::Sized : MassMatrix::None);
   // Dense storage (m × nv) only for the formulations that assemble A.
@@ -133,6 +134,23 @@ bool Simulator::Impl::decideContactModes(std::string& error) {
   applyLatches();
   integrator_->reset();
   return ok;
+}
+
+// A compliant contact is a spring and damper only a time-stepping step
+// models (its normal force from the gap at the step's end); the events hold
+// every closed gap at zero. So a scene with one is time-stepped throughout:
+// auto becomes timestepping, and events is refused, naming the contact.
+void Simulator::Impl::chooseSchemeForCompliance() {
+  for (const auto& c : constraints_) {
+    if (!c->unilateral() || !c->contactLaw().compliant()) continue;
+    if (options_.scheme == ContactScheme::Events)
+      throw std::invalid_argument(
+          "Simulator: contact '" + c->name() +
+          "' is compliant (a normal stiffness): compliant contacts are time-stepped — use the "
+          "contact scheme auto or timestepping, or make the contact rigid");
+    options_.scheme = ContactScheme::TimeStepping;
+    return;
+  }
 }
 
 void Simulator::Impl::setJointForces(JointForces tau) {

@@ -49,6 +49,7 @@ struct Simulator::Impl {
   void setJointForces(JointForces tau);
   void setActuators(std::vector<Actuator> actuators);
   void composeJointForces();
+  void chooseSchemeForCompliance();
   StepStatus step(double h);
   const ContactFrame& contactFrame(int constraint) const;
   bool openTimeSteppingWindow(const std::string& why);

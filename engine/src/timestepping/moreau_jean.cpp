@@ -35,6 +35,8 @@ MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
     k.mu = con.friction();
     k.mu_kinetic = std::isfinite(con.kineticFriction()) ? con.kineticFriction() : k.mu;
     k.restitution = con.restitution();
+    k.stiffness = con.contactLaw().normal_stiffness;
+    k.damping = con.contactLaw().normal_damping;
     const bool coulomb = std::isfinite(k.mu);
     for (int r = 0; r < con.rows(); ++r) {
       if (r == k.normal) continue;
@@ -53,6 +55,7 @@ MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
   rebound_.assign(constraints.size(), 0);
   warm_.assign(6 * all_.size(), 0.0);
   slid_.assign(all_.size(), 0);
+  compliance_.assign(all_.size(), 0.0);
   restituted_.assign(all_.size(), 0);
   problem_.reserve(rows, static_cast<int>(all_.size()));
   servos_ = ImplicitServos(model, std::move(servos), rows);
@@ -140,9 +143,48 @@ void MoreauJean::selectCandidates(const ConstraintData& cdata, double h, double 
     // open gap may close within the step, to land on g = 0 at its end
     // (q⁺ = q + h v⁺ at θ = 1), and a gap at round-off below 0 reopens.
     const double approach = -uminus_[at];
+    compliance_[k] = 0;
+    restituted_[k] = 0;
+    if (cand.stiffness > 0) continue;  // (its target once the step's θ is known: below)
     problem_.target[o] = ufree_[at] - gap / h;  // g⁺ ≈ g̃ + h (u⁺ − u_free) ≥ 0
     restituted_[k] = approach > rest_speed && cand.restitution * approach > problem_.target[o];
     if (restituted_[k]) problem_.target[o] = cand.restitution * approach;
+  }
+  // The step's θ: ½ — the trapezoidal rule's position, exact in free fall
+  // and for the work of gravity on a body — when no rigid contact lands by
+  // its gap target (which needs θ = 1) and no joint force acts; else the
+  // options' θ. (With a force that grows with the displacement — a servo, a
+  // spring in the caller's forces — θ = ½ on an explicit force amplifies
+  // each step by 1 + (ω h)²/4; θ = 1 keeps it bounded, symplectic Euler.)
+  bool rigid = false;
+  for (int k : active_) rigid = rigid || !(all_[k].stiffness > 0);
+  theta_ = rigid || joint_forces_ ? options_.theta : 0.5;
+  for (int j = 0; j < static_cast<int>(active_.size()); ++j) {
+    const int k = active_[j];
+    const Candidate& cand = all_[k];
+    if (!(cand.stiffness > 0)) continue;
+    // A compliant normal (Kelvin–Voigt at the step's end): with the gap at
+    // q, g = g̃ − h u_free, and g⁺ = g + h (θ u⁺ + (1 − θ) u⁻),
+    // Pₙ = max(0, h (−k g⁺ − c u⁺)) = max(0, h a − D u⁺),
+    //   a = k (h u_free − g̃ − h (1 − θ) u⁻),   D = h (h θ k + c):
+    // u⁺ + Pₙ/D ≥ h a/D ⊥ Pₙ ≥ 0, the rigid row's law with 1/D added to
+    // W's diagonal (addCompliance) — a regularized row, as MuJoCo's soft
+    // constraints and Drake's SAP compliant contact.
+    const int at = first_[k], o = problem_.blocks[j].first;
+    const double gap = cdata.gap[cdata.offset[cand.c] + cand.normal];
+    const double D = h * (h * theta_ * cand.stiffness + cand.damping);
+    compliance_[k] = 1 / D;
+    problem_.target[o] =
+        h * cand.stiffness * (h * ufree_[at] - gap - h * (1 - theta_) * uminus_[at]) / D;
+  }
+}
+
+// W's diagonal on the compliant normals: + 1/D (selectCandidates), so the
+// problem's u on such a row is the velocity plus Pₙ/D.
+void MoreauJean::addCompliance() {
+  for (int j = 0; j < static_cast<int>(active_.size()); ++j) {
+    const double r = compliance_[active_[j]];
+    if (r > 0) problem_.W(problem_.blocks[j].first, problem_.blocks[j].first) += r;
   }
 }
 
@@ -153,6 +195,7 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
   error_.clear();
   work_ = {};
   servos_settled_ = true;
+  joint_forces_ = static_cast<bool>(tau_fn) || !servos_.empty();
   for (int k = 0; k < static_cast<int>(all_.size()); ++k)
     slid_[k] = cdata.isSliding(all_[k].c) ? 1 : 0;  // (the last step's mode, either scheme's)
   if (!servos_.empty()) {
@@ -206,8 +249,11 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
     const int d = servos_.dof(i);
     work_.joint += 0.5 * servos_.P()[i] * (v0_[d] + v[d]);
   }
-  // q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v).
-  vfree_ = options_.theta * v + (1 - options_.theta) * v0_;
+  // q⁺ = q ⊕ h (θ v⁺ + (1 − θ) v), the step's θ (selectCandidates): ½ in
+  // flight, where θ = 1 (the landing's rule) lost half the potential
+  // energy a first step exchanged — a drop started in time-stepping was
+  // stopped as diverging at its first step.
+  vfree_ = theta_ * v + (1 - theta_) * v0_;
   integrate(model, q, vfree_, h, qnext_);
   q.swap(qnext_);
   return true;
@@ -238,6 +284,7 @@ bool MoreauJean::solveContacts(const Model& model, Data& data, const ConstraintL
   if (!delassus_.respond(model, data, constraints, cdata, solver, qnext_, vfree_, tau_, vdot_,
                          map_, n, res2_, problem_.W, error_))
     return false;
+  addCompliance();
   problem_.solve(options_.residual_tol, options_.max_sweeps);
   return true;
 }
@@ -334,6 +381,7 @@ bool MoreauJean::solveWithServos(const Model& model, Data& data, const Constrain
     for (int i = 0; i < n; ++i)
       problem_.u_free[i] = delassus_.J.row(map_[i]).dot(vfree0_) + delassus_.b[map_[i]];
     servos_.eliminate(W_all_, n, u_servo_, problem_.W, problem_.u_free);
+    addCompliance();
     problem_.solve(options_.residual_tol, options_.max_sweeps);
     settled = servos_.impulses(W_all_, n, problem_.P);
   }
@@ -361,7 +409,9 @@ void MoreauJean::finish(const ConstraintData& cdata, const VecX& v0, const VecX&
     const ProblemBlock& b = p.blocks[j];
     const int o = b.first, at = first_[k];
     for (int i = 0; i < b.rows(); ++i) {
-      const double P = p.P[o + i], umid = 0.5 * (uminus_[at + i] + p.u[o + i]);
+      // (A compliant normal's problem velocity holds Pₙ/D beside the motion's.)
+      const double P = p.P[o + i], u_end = p.u[o + i] - (i == 0 ? compliance_[k] * P : 0.0);
+      const double umid = 0.5 * (uminus_[at + i] + u_end);
       (i >= 1 && i <= b.nf ? work_.friction : work_.impact) -= P * umid;
       work_.support -= P * delassus_.b[at + i];
       warm_[6 * k + i] = P;

@@ -52,6 +52,7 @@ struct Candidate {
   int e[6] = {-1, -1, -1, -1, -1, -1};
   double mu = 0, restitution = 0;
   double mu_kinetic = 0;  ///< the cone's μ for a contact that slid at the last step
+  double stiffness = 0, damping = 0;  ///< a compliant normal (ContactLaw); 0: rigid
   int rows() const { return 1 + nf + ne; }
 };
 
@@ -103,6 +104,7 @@ class MoreauJean {
                     const Simulator::JointForces& tau_fn, double t, const VecX& q,
                     const VecX& v, double h);
   void selectCandidates(const ConstraintData& cdata, double h, double rest_speed);
+  void addCompliance();
   bool solveContacts(const Model& model, Data& data, const ConstraintList& constraints,
                      ConstraintData& cdata, ConstrainedSolver& solver, double t_end, int n);
   void endVelocity(int n, VecX& v) const;
@@ -125,6 +127,7 @@ class MoreauJean {
   std::vector<char> slid_;         ///< per all_: sliding at the step's start (μₖ)
   std::vector<char> restituted_;   ///< per all_: its normal target is Newton's restitution
   std::vector<double> warm_;       ///< per all_ (6 each): the last step's impulses
+  std::vector<double> compliance_; ///< per all_: this step's 1/D of a compliant normal (0: rigid)
   std::vector<int> map_;           ///< per problem row: its row in the Delassus J
   int rows_ = 0;                   ///< rows of every candidate (J's layout)
   ContactProblem problem_;
@@ -134,6 +137,8 @@ class MoreauJean {
   VecX mobility_;                  ///< per servo: (M⁻¹)_dd under the bilateral rows, for the gate
   VecX u_servo_, vfree0_;          ///< servo rows' and v's free velocity without the servos
   bool servos_settled_ = true;     ///< the servos' limited set settled this step
+  double theta_ = 1;               ///< this step's θ (selectCandidates)
+  bool joint_forces_ = false;      ///< joint forces act (the caller's or servos): θ stays the options'
   Delassus delassus_;
   VecX uminus_, ufree_;            ///< every candidate row at v and at v_free
   VecX tau_, vfree_, vdot_, lambda_, impulse_, v0_, qnext_;

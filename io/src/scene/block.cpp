@@ -139,7 +139,7 @@ std::optional<Shape> parseExplicitShape(const XmlSource& src, const TiXmlElement
   static const char* const kCommon[] = {"name",      "link",        "kind",      "support",
                                         "mu",        "direction",   "restitution", "unilateral",
                                         "mu_static", "mu_kinetic", "mu_spin",  "points",
-                                        "creep_speed"};
+                                        "creep_speed", "normal_stiffness", "normal_damping"};
   auto allow = [&](const std::vector<const char*>& extra) {
     for (const TiXmlAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string n = a->Name();
@@ -255,6 +255,22 @@ ContactDecl parseContact(const XmlSource& src, const TiXmlElement* e) {
     if (has(e, "mu_static"))
       fail(src, e, "'creep_speed' takes one coefficient 'mu', not 'mu_static' with "
                    "'mu_kinetic': a regularized contact never sticks");
+  }
+  if (has(e, "normal_stiffness") || has(e, "normal_damping")) {
+    if (!has(e, "normal_stiffness"))
+      fail(src, e, "'normal_damping' needs a 'normal_stiffness' (a damper alone does not hold "
+                   "the contact)");
+    d.spec.normal_stiffness = number(src, e, "normal_stiffness");
+    if (!(d.spec.normal_stiffness > 0 && std::isfinite(d.spec.normal_stiffness)))
+      fail(src, e, "'normal_stiffness' must be a positive stiffness (N/m)");
+    if (has(e, "normal_damping")) {
+      d.spec.normal_damping = number(src, e, "normal_damping");
+      if (!(d.spec.normal_damping >= 0 && std::isfinite(d.spec.normal_damping)))
+        fail(src, e, "'normal_damping' must be ≥ 0 (N·s/m)");
+    }
+    if (has(e, "restitution"))
+      fail(src, e, "a compliant contact takes no 'restitution': its 'normal_damping' sets what "
+                   "an impact keeps");
   }
   if (has(e, "restitution")) {
     d.spec.restitution = number(src, e, "restitution");
