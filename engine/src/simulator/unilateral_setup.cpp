@@ -36,6 +36,11 @@ static void checkContactLaw(const Constraint& con) {
   if (!(creep >= 0 && std::isfinite(creep)))
     throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has creep speed " +
                                 std::to_string(creep) + " (must be ≥ 0 and finite)");
+  const double k = law.normal_stiffness, c = law.normal_damping;
+  if (!(k >= 0 && std::isfinite(k) && c >= 0 && std::isfinite(c)) || (c > 0 && !(k > 0)))
+    throw std::invalid_argument("Simulator: constraint '" + con.name() + "' has normal stiffness " +
+                                std::to_string(k) + " and damping " + std::to_string(c) +
+                                " (both ≥ 0 and finite; a damping needs a stiffness > 0)");
 }
 
 /// The row of unilateral constraint c, its contact law checked.
