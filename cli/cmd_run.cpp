@@ -258,13 +258,17 @@ void printSummary(std::ostream& out, const Scene& scene, const RunSummary& r,
   out << "wall time    " << r.wall_seconds << " s, "
       << 1e6 * r.wall_seconds / std::max<long>(1, c.steps) << " µs per step\n"
       << "energy       E0 = " << r.energy0 << " J, max |E "
-      << (r.events.empty() ? "" : "+ impact losses ") << (r.friction_work > 0 ? "+ friction work " : "")
+      << (r.events.empty() && impactLoss(r) == 0 ? "" : "+ impact losses ")
+      << (r.friction_work > 0 ? "+ friction work " : "")
+      << (r.scheme_energy_loss != 0 ? "+ time-stepping loss " : "")
       << (r.passive ? "" : "− work in ") << "− E0| = " << r.max_energy_deviation
       << " J (" << r.relativeEnergyDeviation() << " relative)\n";
   if (!r.passive || r.friction_work > 0 || impactLoss(r) > 0)
     out << "work         joint forces " << joule(r.joint_work) << ", moving supports "
         << joule(r.support_work) << " in; impacts " << joule(impactLoss(r)) << ", friction "
-        << joule(r.friction_work) << " out\n";
+        << joule(r.friction_work)
+        << (r.scheme_energy_loss != 0 ? ", time-stepping (θ) " + joule(r.scheme_energy_loss) : std::string())
+        << " out\n";
   out
       << "residuals    max |Av+b| = " << r.max_velocity_residual
       << ", max |gap| = " << r.max_gap_residual

@@ -310,6 +310,7 @@ void bindSimulation(py::module_& m) {
       .def_property_readonly("potential_energy", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().potentialEnergy(); })
       .def_property_readonly("energy", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().energy(); })
       .def_property_readonly("impact_energy_loss", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().impactEnergyLoss(); })
+      .def_property_readonly("scheme_energy_loss", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().schemeEnergyLoss(); })
       .def_property_readonly("friction_work", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().frictionWork(); },
                              "Energy taken by sliding friction since the state was set (J).")
       .def_property_readonly("joint_work", [](const PySimulation& s) { Simulation::Guard g(s); return s.simulator().jointWork(); },

@@ -19,10 +19,11 @@ void DivergenceWatch::start(const Simulator& sim) {
 bool DivergenceWatch::check(const Simulator& sim) {
   const double energy = sim.energy();
   const double potential = energy - sim.kineticEnergy();
-  deviation_ = std::abs(energy + sim.impactEnergyLoss() + sim.frictionWork() - sim.jointWork() -
-                        sim.supportWork() - energy0_);
+  deviation_ = std::abs(energy + sim.impactEnergyLoss() + sim.frictionWork() +
+                        sim.schemeEnergyLoss() - sim.jointWork() - sim.supportWork() - energy0_);
   scale_ = std::max({scale_, sim.kineticEnergy(), std::abs(potential - potential0_), std::abs(sim.jointWork()),
-                     std::abs(sim.supportWork()), std::abs(sim.impactEnergyLoss()), std::abs(sim.frictionWork())});
+                     std::abs(sim.supportWork()), std::abs(sim.impactEnergyLoss()), std::abs(sim.frictionWork()),
+                     std::abs(sim.schemeEnergyLoss())});
   if (!enabled_) return true;
   const double round_off = 1e-9 * std::max(std::abs(energy0_), std::abs(energy));
   return deviation_ <= bound_ * scale_ + round_off;  // false for a NaN deviation too

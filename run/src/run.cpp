@@ -243,6 +243,7 @@ bool SummaryObserver::check(Simulator& sim, const StepStatus&) {
     s_.failure = why.str() + run_detail::stepStabilityCause(scene_, sim, options_);
     s_.impact_energy_loss = sim.impactEnergyLoss();
     s_.friction_work = sim.frictionWork();
+    s_.scheme_energy_loss = sim.schemeEnergyLoss();
     s_.joint_work = sim.jointWork();
     s_.support_work = sim.supportWork();
     sim.setState(t_good_, q_good_, v_good_);  // (restarts the loss counters)
@@ -341,6 +342,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options, const RunObse
   if (!observer.restored()) {
     s.impact_energy_loss = sim.impactEnergyLoss();
     s.friction_work = sim.frictionWork();
+    s.scheme_energy_loss = sim.schemeEnergyLoss();
     s.joint_work = sim.jointWork();
     s.support_work = sim.supportWork();
   }

@@ -107,6 +107,13 @@ class Simulator {
   /// are counted in impactEnergyLoss()).
   double jointWork() const;
   double supportWork() const;
+  /// Energy the time-stepping scheme itself took since setState() (J, either
+  /// sign): at θ = 1 a Moreau–Jean step ends at q + h v⁺, not at the
+  /// trapezoidal position its work terms match, ½ m g² h² lower in a free
+  /// fall (docs/contacts.md §10); 0 under the events. With it the balance above closes for a
+  /// time-stepped scene too: E + impactEnergyLoss() + frictionWork() +
+  /// schemeEnergyLoss() − jointWork() − supportWork() = E(0).
+  double schemeEnergyLoss() const;
   /// Whether unilateral constraint `c` is closed now.
   bool isClosed(int constraint) const;
   const SimulatorCounters& counters() const;

@@ -91,6 +91,7 @@ bool Simulator::Impl::setState(double t, const VecX& q, const VecX& v) {
   events_.clear();
   state_error_.clear();
   dissipated_ = 0;
+  scheme_loss_ = 0;
   work_ = work_prev_ = {};
   if (uni_ && options_.contacts.enabled) {
     if (!decideContactModes(state_error_)) state_error_ = "initial contact modes: " + state_error_;

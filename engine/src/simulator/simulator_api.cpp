@@ -48,6 +48,7 @@ const VecX& Simulator::lastImpulse() const { return impl_->impulse_; }
 const std::vector<ContactEvent>& Simulator::events() const { return impl_->events_; }
 double Simulator::impactEnergyLoss() const { return impl_->dissipated_; }
 double Simulator::frictionWork() const { return impl_->work_[Impl::kFrictionWork]; }
+double Simulator::schemeEnergyLoss() const { return impl_->scheme_loss_; }
 double Simulator::jointWork() const { return impl_->work_[Impl::kJointWork]; }
 double Simulator::supportWork() const { return impl_->work_[Impl::kSupportWork]; }
 bool Simulator::isClosed(int constraint) const { return impl_->cdata_->isActive(constraint); }

@@ -203,6 +203,7 @@ struct Simulator::Impl {
   std::vector<ContactEvent> events_;
   std::string state_error_;
   double dissipated_ = 0;
+  double scheme_loss_ = 0;  // the time-stepping θ-method's own loss (StepWork::scheme)
   // Work integrals since setState(), now and at the last step's start (a
   // step redone to an event starts from there): the Field's rates.
   enum WorkIndex { kFrictionWork, kJointWork, kSupportWork, kWorkTerms };

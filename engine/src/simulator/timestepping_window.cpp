@@ -240,6 +240,7 @@ void Simulator::Impl::recordTimeSteppingWork() {
   counters_.max_contact_residual = std::max(counters_.max_contact_residual, mj_->residual());
   const timestepping::StepWork& w = mj_->work();
   dissipated_ += w.impact;
+  scheme_loss_ += w.scheme;
   work_[kFrictionWork] += w.friction;
   work_[kJointWork] += w.joint;
   work_[kSupportWork] += w.support;

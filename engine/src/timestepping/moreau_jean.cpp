@@ -2,6 +2,7 @@
 #include "timestepping/moreau_jean.hpp"
 
 #include <appell/configuration.hpp>
+#include <appell/dynamics.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -71,7 +72,7 @@ MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
   u_servo_ = VecX::Zero(ns);
   vfree0_ = VecX::Zero(model.nv);
   rows_ = rows;
-  qnext_ = VecX::Zero(model.nq);
+  qnext_ = qmid_ = VecX::Zero(model.nq);
   uminus_ = ufree_ = VecX::Zero(std::max(rows, 1));
   tau_ = vfree_ = vdot_ = v0_ = VecX::Zero(model.nv);
   ConstraintData cd(model, constraints, DenseRows::None);
@@ -255,6 +256,11 @@ bool MoreauJean::step(const Model& model, Data& data, const ConstraintList& cons
   // stopped as diverging at its first step.
   vfree_ = theta_ * v + (1 - theta_) * v0_;
   integrate(model, q, vfree_, h, qnext_);
+  if (theta_ != 0.5) {
+    vfree_ = 0.5 * (v + v0_);
+    integrate(model, q, vfree_, h, qmid_);
+    work_.scheme = potentialEnergy(model, data, qmid_) - potentialEnergy(model, data, qnext_);
+  }
   q.swap(qnext_);
   return true;
 }

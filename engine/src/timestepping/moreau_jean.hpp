@@ -62,6 +62,14 @@ struct StepWork {
   double friction = 0;  ///< −Pₜ·(u⁻ₜ + u⁺ₜ)/2
   double joint = 0;     ///< h τ·(v + v⁺)/2
   double support = 0;   ///< −Pᵀb − h λᵀb: rows that move in time
+  /// The θ-method's own loss, V(q_½) − V(q⁺): the potential energy of the
+  /// step's end against the trapezoidal position q_½ = q ⊕ h (v + v⁺)/2,
+  /// which the work terms above are consistent with. (θ − ½) h Q_gᵀ Δv to
+  /// first order — ½ m g² h² a step of a free fall at θ = 1, zero at θ = ½
+  /// (Acary, "Energy conservation and dissipation properties of time-
+  /// integration methods for nonsmooth elastodynamics with contact", ZAMM
+  /// 96, 2016: the scheme dissipates for θ > ½).
+  double scheme = 0;
 };
 
 class MoreauJean {
@@ -141,7 +149,7 @@ class MoreauJean {
   bool joint_forces_ = false;      ///< joint forces act (the caller's or servos): θ stays the options'
   Delassus delassus_;
   VecX uminus_, ufree_;            ///< every candidate row at v and at v_free
-  VecX tau_, vfree_, vdot_, lambda_, impulse_, v0_, qnext_;
+  VecX tau_, vfree_, vdot_, lambda_, impulse_, v0_, qnext_, qmid_;
   ConstrainedResult res_, res2_;
   StepWork work_;
   std::string error_;

@@ -205,6 +205,7 @@ struct RunSummary {
   double max_energy_deviation = 0; ///< max |E + impact losses + friction work − work in − E₀| (J)
   double impact_energy_loss = 0;   ///< kinetic energy taken by impacts (J)
   double friction_work = 0;        ///< energy taken by sliding friction (J, Simulator::frictionWork)
+  double scheme_energy_loss = 0;   ///< the time-stepping scheme's own loss (J, Simulator::schemeEnergyLoss)
   double joint_work = 0;           ///< work of the joint forces, ∫ τ·v dt (J)
   double support_work = 0;         ///< work of constraints that move in time, ∫ −λᵀb dt (J)
   std::vector<RunEvent> events;    ///< contact events, in time order
