@@ -1,11 +1,12 @@
 // Compliant contacts (ContactLaw::normal_stiffness, normal_damping; docs/
 // contacts.md §10): a table on four compliant feet, one of them 0.1 mm
 // long, carries the loads its warp demands — the closed form of a rigid body
-// on four springs, where rigid feet leave the split indeterminate; a ball
-// rests at its static deflection m g / k; the event scheme refuses them;
-// the scene file checks the attributes. And a drop started in time-stepping
-// keeps its energy in flight (the trapezoidal position of a contact-free step)
-// or, driven, books the θ-method's own term ½ m g² h² a step.
+// on four springs, where rigid feet leave the split indeterminate, and its
+// heave the mean static deflection m g/(4k); a drop onto them keeps its
+// balance; the event scheme refuses them; the scene file checks the
+// attributes. And a drop started in time-stepping keeps its energy in
+// flight (the trapezoidal position of a contact-free step) or, driven,
+// books the θ-method's own term ½ m g² h² a step.
 #include <gtest/gtest.h>
 
 #include <appell/run.hpp>
