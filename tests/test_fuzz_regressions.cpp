@@ -75,6 +75,7 @@ TEST(FuzzRegressions, DamagedColladaNumberListsAreRefusedBeforeAssimpReadsThem) 
   };
   refused(p, p.substr(0, 10) + "\xe0\xc5" + p.substr(12), "<p>: an index list holds 0xe0");
   refused(p, "<p>0.0839018 -0.017" + p.substr(19), "<p>: an index list holds '.'");
+  refused(p, p.substr(0, 10) + "\f" + p.substr(11), "<p>: an index list holds 0x0c");
   refused(p, "<p>98765432109876 " + p.substr(3), "<p>: an index or count larger than the file could hold");
   refused("count=\"3270\"", "count=\"3270000000\"", "more values than the file could hold");
   refused("0.0796148", "0.07x6148", "<float_array>: a number list holds 'x'");
