@@ -39,8 +39,15 @@ int Scene::contactIndex(const std::string& name) const {
   return -1;
 }
 
+namespace {
+// Whether the scene declares constant efforts (<effort>): a non-zero tau of nv.
+bool hasConstantForces(const Scene& s) {
+  return s.tau.size() > 0 && s.tau.size() == s.model.nv && s.tau.cwiseAbs().maxCoeff() > 0;
+}
+}  // namespace
+
 Simulator::JointForces Scene::jointForces() const {
-  const bool constant = tau.size() > 0 && tau.size() == model.nv && tau.cwiseAbs().maxCoeff() > 0;
+  const bool constant = hasConstantForces(*this);
   if (!constant && actuators.empty()) return {};
   // Copies of the forces (a later change to the scene does not reach a
   // running simulation); the model by reference (its owner outlives us).
@@ -52,7 +59,7 @@ Simulator::JointForces Scene::jointForces() const {
 }
 
 Simulator::JointForces Scene::constantJointForces() const {
-  if (!(tau.size() > 0 && tau.size() == model.nv && tau.cwiseAbs().maxCoeff() > 0)) return {};
+  if (!hasConstantForces(*this)) return {};
   return [tau = tau](double, const VecX&, const VecX&, VecX& out) { out = tau; };
 }
 
