@@ -3,12 +3,12 @@
 #   - each Google Benchmark program (bench/bm_*.cpp) → bench/results/data/NAME.json
 #     and its table of medians bench/results/tables/NAME.md (bench/tables.py);
 #   - the report programs → speed_error.{csv,gp,png} (+ tables/speed_error.md),
-#     long_run.{md,csv,gp,png}, peers.{md,csv,gp,png};
+#     long_run.{md,csv,gp,png}, peers.{md,csv,gp,png}, peers_vehicles.md, fc3d.md;
 #   - the Python bindings' thread scaling (python/bench/thread_scaling.py)
 #     → tables/thread_scaling.md;
 #   - `appell info`'s wall time per description (bench/report_info_times.py)
 #     → info_times.md (published robots timed when ROS_PACKAGE_PATH is set);
-#   - the peers (Simbody, MuJoCo) are installed first (scripts/install-peers.sh).
+#   - the peers (Simbody, MuJoCo, Siconos) are installed first (scripts/install-peers.sh).
 # Each page names the command that made it. The analyses in bench/RESULTS.md
 # and bench/results/*.md quote dated runs and link to these pages.
 #
@@ -43,6 +43,7 @@ declare -A ARGS=(
   [report_long_run]="--steps 1000000 --dt 0.01 --out $OUT"
   [report_peers]="--repeats 3 --out $OUT"
   [report_peers_vehicles]="--repeats 3 --out $OUT"
+  [report_fc3d]="--repeats 3 --out $OUT"
   [thread_scaling]="--repeat 5"
   [report_info_times]="--repeats 5 --out $OUT/info_times.md"
 )
@@ -53,6 +54,7 @@ run() {
   [ -n "${ARGS[$name]+x}" ] || { echo "bench.sh: no benchmark named '$name' (one of: ${!ARGS[*]})" >&2; return 2; }
   [ "$name" = report_peers ] && exe=build/bench/peers/report_peers
   [ "$name" = report_peers_vehicles ] && exe=build/bench/peers/report_peers_vehicles
+  [ "$name" = report_fc3d ] && exe=build/bench/peers/report_fc3d
   [ "$name" = thread_scaling ] && exe=python/bench/thread_scaling.py
   [ "$name" = report_info_times ] && exe=bench/report_info_times.py
   [ -e "$exe" ] || { echo "bench.sh: $exe was not built" >&2; return 1; }
@@ -79,7 +81,7 @@ run() {
 }
 
 ALL=(bm_dynamics bm_evaluation bm_constrained_scaling bm_events bm_friction bm_collision bm_parallel
-     report_speed_error report_long_run report_peers report_peers_vehicles thread_scaling report_info_times)
+     report_speed_error report_long_run report_peers report_peers_vehicles report_fc3d thread_scaling report_info_times)
 total_start=$(date +%s)
 for name in "${@:-${ALL[@]}}"; do run "$name"; done
 echo "bench.sh: all done in $(( $(date +%s) - total_start )) s; results in $OUT"

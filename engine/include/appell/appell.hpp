@@ -31,6 +31,7 @@
 #include <appell/joint_limit.hpp>
 #include <appell/projection.hpp>
 #include <appell/simulator.hpp>
+#include <appell/contact_problem.hpp>
 
 // Analysis.
 #include <appell/equilibria.hpp>

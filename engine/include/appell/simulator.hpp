@@ -28,6 +28,8 @@
 
 namespace appell {
 
+struct ContactProblemData;  // contact_problem.hpp
+
 class Simulator {
  public:
   /// τ(t, q, v) written into `tau` (size nv, zeroed before the call).
@@ -126,6 +128,9 @@ class Simulator {
   bool openTimeSteppingWindow(const std::string& why);
   /// Why the last window opened (empty before the first).
   const std::string& windowReason() const;
+  /// Copies the last step's contact problem into `out` (contact_problem.hpp);
+  /// false when that step was not time-stepped or had no contact candidate.
+  bool contactProblem(ContactProblemData& out) const;
 
   const Model& model() const;
   const ConstraintList& constraints() const;

@@ -266,6 +266,7 @@ StepStatus Simulator::Impl::step(double h) {
   v_prev_ = v_;
   work_prev_ = work_;
   events_.clear();
+  ts_step_start_ = std::numeric_limits<double>::quiet_NaN();
   if (stepping_) return timeSteppingStep(h);
   StepStatus st = attemptStep(h);
   // Sticking contacts that became over-constrained inside the step: one

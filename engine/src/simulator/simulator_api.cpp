@@ -3,6 +3,11 @@
 #include <appell/simulator.hpp>
 
 #include "simulator/simulator_impl.hpp"
+#include "timestepping/moreau_jean.hpp"
+
+#include <appell/contact_problem.hpp>
+
+#include <cmath>
 
 namespace appell {
 
@@ -57,6 +62,12 @@ ContactScheme Simulator::stepScheme() const {
   return impl_->stepping_ ? ContactScheme::TimeStepping : ContactScheme::Events;
 }
 const std::string& Simulator::windowReason() const { return impl_->window_reason_; }
+bool Simulator::contactProblem(ContactProblemData& out) const {
+  if (std::isnan(impl_->ts_step_start_) || !impl_->mj_ || impl_->mj_->candidates() == 0) return false;
+  impl_->mj_->record(out);
+  out.t = impl_->ts_step_start_;
+  return true;
+}
 
 const Model& Simulator::model() const { return impl_->model_; }
 const ConstraintList& Simulator::constraints() const { return impl_->constraints_; }

@@ -230,6 +230,9 @@ struct Simulator::Impl {
   std::array<double, kStallMarks> stall_t_{};
   long stall_marks_ = 0, stall_next_ = 0, stall_low_ = 0;
   std::string window_reason_;
+  // The start of the last step when it was time-stepped (NaN: an event
+  // step, or none yet): when mj_ holds that step's contact problem.
+  double ts_step_start_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 // v̇ = f(t, q, v): joint forces, constraint rows, the solver. Failures are

@@ -272,6 +272,7 @@ StepStatus Simulator::Impl::timeSteppingStep(double h) {
     events_.push_back(e);
     window_contact_ = -1;
   }
+  ts_step_start_ = t_;
   if (!mj_->step(model_, *data_, constraints_, *cdata_, *solver_, user_tau_fn_, t_, q_, v_, hs,
                  options_.contacts.rest_speed)) {
     // At a window's first step the events' own reason comes first.

@@ -72,7 +72,7 @@ Vec3 diskNewton(const detail::DiskFactor& H, const Vec3& c, int n, double r) {
 
 void ContactProblem::reserve(int rows, int contacts) {
   W = MatX::Zero(rows, rows);
-  u_free = target = P = u = VecX::Zero(rows);
+  u_free = target = P = u = start = VecX::Zero(rows);
   blocks.reserve(contacts);
   disk_.resize(contacts);
   ldlt_.resize(contacts);
@@ -218,6 +218,7 @@ void ContactProblem::solve(double tol, int max_sweeps) {
   polished = false;
   min_norm_failed_ = false;
   if (n == 0) return;
+  start.head(n) = P.head(n);
   factorBlocks();
   const double scale = std::max(1.0, u_free.head(n).lpNorm<Eigen::Infinity>());
   for (sweeps = 1; sweeps <= max_sweeps; ++sweeps) {

@@ -63,6 +63,7 @@ struct ProblemBlock {
 struct ContactProblem {
   MatX W;              ///< n × n (symmetric positive semidefinite)
   VecX u_free, target, P, u;
+  VecX start;          ///< the P the last solve started from
   std::vector<ProblemBlock> blocks;
   int n = 0;
   int sweeps = 0;

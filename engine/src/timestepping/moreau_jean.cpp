@@ -440,4 +440,23 @@ void MoreauJean::finish(const ConstraintData& cdata, const VecX& v0, const VecX&
   }
 }
 
+// The problem as the public record states it (contact_problem.hpp).
+void MoreauJean::record(ContactProblemData& out) const {
+  const ContactProblem& p = problem_;
+  const int n = p.n;
+  out.W = p.W.topLeftCorner(n, n);
+  out.u_free = p.u_free.head(n);
+  out.target = p.target.head(n);
+  out.warm_start = p.start.head(n);
+  out.P = p.P.head(n);
+  out.blocks.clear();
+  for (int k = 0; k < static_cast<int>(p.blocks.size()); ++k) {
+    const ProblemBlock& b = p.blocks[k];
+    out.blocks.push_back({all_[active_[k]].c, b.first, b.nf, b.ne, b.mu});
+  }
+  out.sweeps = p.sweeps;
+  out.residual = p.residual;
+  out.converged = p.converged;
+}
+
 }  // namespace appell::timestepping

@@ -29,6 +29,7 @@
 #include "timestepping/contact_problem.hpp"
 #include "timestepping/implicit_servos.hpp"
 
+#include <appell/contact_problem.hpp>
 #include <appell/simulator.hpp>
 
 #include <string>
@@ -103,6 +104,9 @@ class MoreauJean {
   double residual() const { return problem_.residual; }
   bool converged() const { return problem_.converged && servos_settled_; }
   bool polished() const { return problem_.polished; }
+  /// Copies the last step's contact problem (its blocks named by constraint)
+  /// into `out` (allocates; not for the step loop).
+  void record(ContactProblemData& out) const;
   /// Candidate contacts of the last step.
   int candidates() const { return static_cast<int>(active_.size()); }
 

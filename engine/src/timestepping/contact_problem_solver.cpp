@@ -1,0 +1,75 @@
+// ContactProblemSolver (appell/contact_problem.hpp): the time-stepping
+// scheme's own contact-problem solver (contact_problem.hpp) over a problem
+// given as data — the same Gauss–Seidel and active-set finish, so a
+// recorded step's problem re-solved from its warm start gives its impulses
+// bit for bit.
+#include <appell/contact_problem.hpp>
+
+#include "timestepping/contact_problem.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace appell {
+
+struct ContactProblemSolver::Impl {
+  timestepping::ContactProblem problem;
+};
+
+namespace {
+
+// The block structure must tile the rows: [n, f…, e…] one after another.
+void checkLayout(const ContactProblemData& d) {
+  const int n = d.rows();
+  int at = 0;
+  for (const ContactProblemBlock& b : d.blocks) {
+    if (b.first != at || b.friction_rows < 0 || b.friction_rows > 2 || b.equality_rows < 0 ||
+        b.equality_rows > 5 || !(b.mu >= 0))
+      throw std::invalid_argument("ContactProblemSolver: block of constraint " +
+                                  std::to_string(b.constraint) + " at row " + std::to_string(b.first) +
+                                  " does not follow the last block, or has a bad row count or μ");
+    at += 1 + b.friction_rows + b.equality_rows;
+  }
+  if (at != n || d.W.rows() != n || d.W.cols() != n || d.target.size() != n)
+    throw std::invalid_argument("ContactProblemSolver: W, u_free, target and the blocks' rows disagree in size");
+}
+
+}  // namespace
+
+ContactProblemSolver::ContactProblemSolver(const ContactProblemData& d)
+    : impl_(std::make_unique<Impl>()) {
+  checkLayout(d);
+  timestepping::ContactProblem& p = impl_->problem;
+  p.reserve(d.rows(), static_cast<int>(d.blocks.size()));
+  for (const ContactProblemBlock& b : d.blocks) p.add(b.friction_rows, b.equality_rows, b.mu);
+  p.W.topLeftCorner(p.n, p.n) = d.W;
+  p.u_free.head(p.n) = d.u_free;
+  p.target.head(p.n) = d.target;
+}
+
+ContactProblemSolver::~ContactProblemSolver() = default;
+ContactProblemSolver::ContactProblemSolver(ContactProblemSolver&&) noexcept = default;
+ContactProblemSolver& ContactProblemSolver::operator=(ContactProblemSolver&&) noexcept = default;
+
+ContactProblemSolver::Result ContactProblemSolver::solve(const VecX& start, double tol,
+                                                         int max_sweeps, VecX& P, VecX& u) {
+  timestepping::ContactProblem& p = impl_->problem;
+  p.P.head(p.n) = start;
+  p.solve(tol, max_sweeps);
+  P = p.P.head(p.n);
+  u = p.u.head(p.n);
+  return {p.sweeps, p.residual, p.converged, p.polished};
+}
+
+double ContactProblemSolver::residual(const VecX& P) {
+  timestepping::ContactProblem& p = impl_->problem;
+  p.P.head(p.n) = P;
+  p.u.head(p.n) = p.u_free.head(p.n);
+  p.u.head(p.n).noalias() += p.W.topLeftCorner(p.n, p.n) * P;
+  double r = 0;
+  for (const timestepping::ProblemBlock& b : p.blocks) r = std::max(r, p.blockResidual(b));
+  return r;
+}
+
+}  // namespace appell

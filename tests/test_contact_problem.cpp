@@ -1,0 +1,124 @@
+// The time-stepping step's contact problem as data (appell/contact_problem.hpp):
+// what Simulator::contactProblem records is the problem the step solved —
+// its impulses balance the load, and ContactProblemSolver re-solves it to
+// the same impulses bit for bit — and bad problems are refused by name.
+#include <gtest/gtest.h>
+
+#include <appell/contact_problem.hpp>
+#include <appell/simulator.hpp>
+
+#include "corner_box.hpp"
+#include "scene.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+using namespace appell;
+using namespace appell::scenes;
+
+namespace {
+
+constexpr double kG = 9.81, kMass = 2.0, kMu = 0.5, kPush = 3.0, kStep = 1e-3;
+// The problem's velocities are solved to 1e-10 m/s (the default
+// residual_tol); the box's heave after the step, (Σ Pₙ − m g h)/m, is then
+// within that of zero, so Σ Pₙ within m · 1e-10 of m g h (twice, for the
+// four corners' combination).
+constexpr double kLoadTol = 2 * kMass * 1e-10;
+
+// A box on its four lower corners (μ 0.5), pushed at its centre by a
+// constant 3 N — below μ m g = 9.81 N, so it sticks —, stepped `steps` times.
+struct PushedBox {
+  BuiltScene s = cornerBox({.half = Vec3(0.2, 0.1, 0.05), .mass = kMass, .h = 0, .R = Mat3::Identity(),
+                            .kind = ContactKind::Rolling, .mu = kMu});
+  std::unique_ptr<Simulator> sim;
+  explicit PushedBox(ContactScheme scheme, int steps) {
+    SimulatorOptions o;
+    o.scheme = scheme;
+    o.timestepping.step = kStep;
+    sim = std::make_unique<Simulator>(s.model, s.constraints,
+                                      makeSolver(Formulation::Tree, s.model, s.constraints),
+                                      IntegratorType::DormandPrince54, IntegratorOptions{}, o);
+    sim->setJointForces([](double, const VecX& q, const VecX&, VecX& tau) {
+      tau.tail<3>() = floatingRotation(q, 0).transpose() * Vec3(kPush, 0, 0);
+    });
+    EXPECT_TRUE(sim->setState(0, s.q0, s.v0)) << sim->lastStateError();
+    for (int i = 0; i < steps; ++i) EXPECT_TRUE(sim->step(kStep).ok);
+  }
+};
+
+}  // namespace
+
+// The recorded problem is the step's: four cones, their normal impulses
+// carrying the weight over the step (Σ Pₙ = m g h) and the impulses
+// within the solver's residual; re-solved from its warm start by
+// ContactProblemSolver, the same impulses to the last bit.
+TEST(ContactProblem, RecordedStepResolvesToItsImpulses) {
+  PushedBox box(ContactScheme::TimeStepping, 5);
+  ContactProblemData d;
+  ASSERT_TRUE(box.sim->contactProblem(d));
+  EXPECT_NEAR(d.t, 4 * kStep, 1e-15);
+  ASSERT_EQ(d.blocks.size(), 4u);
+  double load = 0;
+  for (const ContactProblemBlock& b : d.blocks) {
+    EXPECT_EQ(b.friction_rows, 2);
+    EXPECT_EQ(b.equality_rows, 0);
+    EXPECT_EQ(b.mu, kMu);
+    EXPECT_EQ(box.sim->constraints()[b.constraint]->name().rfind("box", 0), 0u)
+        << box.sim->constraints()[b.constraint]->name();
+    load += d.P[b.first];
+  }
+  EXPECT_NEAR(load, kMass * kG * kStep, kLoadTol);
+  EXPECT_LT(box.sim->v().norm(), 1e-8) << "it sticks";
+  EXPECT_TRUE(d.converged);
+
+  ContactProblemSolver solver(d);
+  VecX P, u;
+  const SimulatorOptions defaults;
+  const ContactProblemSolver::Result r =
+      solver.solve(d.warm_start, defaults.timestepping.residual_tol, defaults.timestepping.max_sweeps, P, u);
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(r.sweeps, d.sweeps);
+  EXPECT_EQ(r.residual, d.residual);
+  for (int i = 0; i < d.rows(); ++i) EXPECT_EQ(P[i], d.P[i]) << "row " << i;
+  EXPECT_EQ(solver.residual(P), d.residual);
+  // u = W P + u_free, and every normal velocity meets its target.
+  const VecX u_check = d.W * P + d.u_free;
+  EXPECT_LT((u - u_check).lpNorm<Eigen::Infinity>(), 1e-14);
+  for (const ContactProblemBlock& b : d.blocks) EXPECT_GT(u[b.first] - d.target[b.first], -1e-10);
+}
+
+// From zero instead of the warm start: another iterate, the same load
+// (the split among four corners is indeterminate; the sum is not).
+TEST(ContactProblem, ColdStartCarriesTheSameLoad) {
+  PushedBox box(ContactScheme::TimeStepping, 5);
+  ContactProblemData d;
+  ASSERT_TRUE(box.sim->contactProblem(d));
+  ContactProblemSolver solver(d);
+  VecX P, u;
+  const ContactProblemSolver::Result r = solver.solve(VecX::Zero(d.rows()), 1e-10, 2000, P, u);
+  ASSERT_TRUE(r.converged);
+  double load = 0;
+  for (const ContactProblemBlock& b : d.blocks) load += P[b.first];
+  EXPECT_NEAR(load, kMass * kG * kStep, kLoadTol);
+  EXPECT_LE(solver.residual(P), 1e-10 * std::max(1.0, d.u_free.lpNorm<Eigen::Infinity>()));
+}
+
+// No problem to record after an event step; a problem whose blocks do not
+// tile its rows is refused with the constraint named.
+TEST(ContactProblem, EventStepsRecordNothingAndBadLayoutsAreRefused) {
+  PushedBox box(ContactScheme::Events, 1);
+  ContactProblemData d;
+  EXPECT_FALSE(box.sim->contactProblem(d));
+
+  PushedBox stepped(ContactScheme::TimeStepping, 1);
+  ASSERT_TRUE(stepped.sim->contactProblem(d));
+  d.blocks[1].first += 1;
+  try {
+    ContactProblemSolver bad(d);
+    FAIL() << "a gap between blocks was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("block of constraint " + std::to_string(d.blocks[1].constraint)),
+              std::string::npos)
+        << e.what();
+  }
+}
