@@ -7,8 +7,8 @@
 //     line, a steering step at t = 2 s that makes every tyre slip) under
 //     auto and under time-stepping, 10 s;
 //   - a box on four corners pushed to sliding by F = k t (μ 0.5, k 30 N/s,
-//     0.7 s) under time-stepping (h = 1 ms) and under events (dopri5, tol
-//     1e-10), with the steps each takes.
+//     0.7 s) under time-stepping (h = 1 ms), under events (dopri5, tol
+//     1e-10) and under auto, with the steps each takes.
 // Each line also gives the work balance's error relative to the energy that
 // moved, and the Gauss–Seidel sweeps per contact problem (time-stepping).
 // Usage: report_contact_schemes [--repeats N | N]   (default 5)
@@ -135,6 +135,7 @@ int main(int argc, char** argv) {
               "wins", "wall/sim", "[min, max]", "balance", "sweeps");
   print("box on 4 corners pushed (0.7 s)", "timestepping", pushedBox(ContactScheme::TimeStepping, repeats));
   print("box on 4 corners pushed (0.7 s)", "events", pushedBox(ContactScheme::Events, repeats));
+  print("box on 4 corners pushed (0.7 s)", "auto", pushedBox(ContactScheme::Auto, repeats));
   const char* skid = "/examples/skid_steer_step/skid_steer_step.urdf";
   print("skid_steer_step (10 s)", "auto", example(skid, 10, ContactScheme::Auto, repeats));
   print("skid_steer_step (10 s)", "timestepping", example(skid, 10, ContactScheme::TimeStepping, repeats));

@@ -86,7 +86,7 @@ TEST(ContactFriction, PushedBallSlipsWhenTheDemandReachesMu) {
       // automatic scheme's stall rule takes for a stall (docs/contacts.md §10,
       // a known limit) — so it is off here.
       SimulatorOptions so;
-      so.timestepping.stall_work = std::numeric_limits<long>::max();
+      so.timestepping.stall_work = so.timestepping.stall_steps = std::numeric_limits<long>::max();
       Simulator sim(s.model, s.constraints, makeSolver(f, s.model, s.constraints), it,
                     appell::test::tightIntegrator(), so);
       sim.setJointForces([&](double t, const VecX& q, const VecX&, VecX& tau) {

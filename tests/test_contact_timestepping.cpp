@@ -345,11 +345,13 @@ TEST(ContactTimeStepping, SkidSteerTurnsAtTheEventsRate) {
 // Protects the automatic scheme on the box on four corners pushed to
 // sliding: the events are exact while it sticks, their steps collapse at the
 // slip onset of four redundant corners (no mode decision fails there, no
-// event piles up), and the stall rule opens one time-stepping window at the
-// onset; after it the events slide the box on to the closed form
-// v(t) = k (t − t*)²/(2m). The events alone take 12 000 – 22 000 steps for
-// 0.7 s (docs/contacts.md §8, known limit (2)); auto ~3 400 (the issue asks
-// ≤ 1 000: the stall's ~3 300 steps before the rule fires are the rest).
+// event piles up: the slip direction of four corners sliding at a speed
+// near zero relaxes at ~μ m g r²/(I |v|), beyond any explicit step), and the
+// step-size rule opens one time-stepping window at the onset after
+// stall_steps = 500 steps; after it the events slide the box on to the
+// closed form v(t) = k (t − t*)²/(2m). The events alone take 12 000 –
+// 22 000 steps for 0.7 s (docs/contacts.md §8, known limit (2)); issue 37
+// asks ≤ 1 000 under auto (the work rule alone took ~3 400).
 TEST(ContactTimeStepping, BoxPushedUnderAutoTakesOneWindowAtItsOnset) {
   const double mu = 0.5, k = 30.0, T = 0.7, t_star = mu * kMass * kG / k;
   BoxScene s = box(0, ContactKind::Rolling, mu);
@@ -369,9 +371,10 @@ TEST(ContactTimeStepping, BoxPushedUnderAutoTakesOneWindowAtItsOnset) {
   std::cout << sim.counters().steps << " steps (" << sim.counters().rejected << " rejected), "
             << sim.counters().timestepping_steps << " time-stepped, window at t = " << t_window << "\n";
   EXPECT_EQ(sim.counters().windows, 1);
-  EXPECT_EQ(sim.windowReason().rfind("the steps stalled: ", 0), 0u) << sim.windowReason();
+  EXPECT_EQ(sim.windowReason().rfind("the step size collapsed: the last 500 steps", 0), 0u)
+      << sim.windowReason();
   EXPECT_NEAR(t_window, t_star, 2e-3) << "at the slip onset";
   const double v = k * (T - t_star) * (T - t_star) / (2 * kMass);
   EXPECT_NEAR(worldLinear(sim).x(), v, 1e-3 * v) << "the window's O(h) error only";
-  EXPECT_LT(sim.counters().steps, 4000) << "the events alone: 12 000 – 22 000";
+  EXPECT_LE(sim.counters().steps, 1000) << "the events alone: 12 000 – 22 000";
 }

@@ -406,7 +406,8 @@ std::unique_ptr<Simulator> carSimulator(const Scene& scene, Formulation f, doubl
   // which the stall rule (docs/contacts.md §10: 5000 evaluations within
   // 10 µs) cannot tell from a stall and would time-step. Off here, where
   // that run is the point of the comparison.
-  if (settle_time == 0) sopt.timestepping.stall_work = std::numeric_limits<long>::max();
+  if (settle_time == 0)
+    sopt.timestepping.stall_work = sopt.timestepping.stall_steps = std::numeric_limits<long>::max();
   auto sim = std::make_unique<Simulator>(scene.model, scene.constraints,
                                          makeSolver(f, scene.model, scene.constraints, solver),
                                          IntegratorType::DormandPrince54, iopt, sopt);

@@ -4,6 +4,8 @@
 #include "arguments.hpp"
 #include "simulation.hpp"
 
+#include <appell/contact_problem.hpp>
+
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
@@ -327,6 +329,21 @@ void bindSimulation(py::module_& m) {
         s.rowResiduals(residual, gap);
         return py::make_tuple(residual, gap);
       }, "(A v + b, g) per row at the current state, open constraints included.")
+      .def("contact_problem", [](const PySimulation& s) -> py::object {
+        Simulation::Guard g(s);
+        ContactProblemData d;
+        if (!s.simulator().contactProblem(d)) return py::none();
+        py::list blocks;
+        for (const ContactProblemBlock& b : d.blocks)
+          blocks.append(py::dict("constraint"_a = b.constraint,
+                                 "name"_a = s.scene().constraints[b.constraint]->name(), "first"_a = b.first,
+                                 "friction_rows"_a = b.friction_rows, "equality_rows"_a = b.equality_rows,
+                                 "mu"_a = b.mu));
+        return py::dict("t"_a = d.t, "W"_a = d.W, "u_free"_a = d.u_free, "target"_a = d.target,
+                        "warm_start"_a = d.warm_start, "P"_a = d.P, "blocks"_a = blocks,
+                        "sweeps"_a = d.sweeps, "residual"_a = d.residual, "converged"_a = d.converged);
+      }, "The last step's contact problem u = W P + u_free (docs/contacts.md §10) as a dict, "
+         "None when that step was not time-stepped or had no contact candidate.")
       .def("body_pose", [](PySimulation& s, py::handle body) {
         Simulation::Guard g(s);
         return s.bodyPose(bodyIndex(s.scene(), body));

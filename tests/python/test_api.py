@@ -287,3 +287,30 @@ def test_actuators_drive_the_scene():
     assert v["left_wheel_joint"] == pytest.approx(5.0, abs=1e-8)
     assert v["root_joint.vx"] == pytest.approx(0.5, abs=1e-9)
     assert abs(v["root_joint.wz"]) < 1e-12
+
+
+def test_a_time_stepped_steps_contact_problem_carries_the_weight_within_its_cones():
+    # The skid-steer standing on its four tyres (its command starts later):
+    # the step's problem is four Coulomb cones on a symmetric positive
+    # semidefinite W, its impulses inside the cones, their normal parts
+    # carrying the weight over the 1 ms step; an event step records none.
+    scene = appell.load_scene(example("skid_steer_step/skid_steer_step.urdf"))
+    sim = appell.Simulation(scene, contacts="timestepping")
+    h = 1e-3
+    for _ in range(20):
+        sim.step(h)
+    p = sim.contact_problem()
+    W, P, blocks = p["W"], p["P"], p["blocks"]
+    assert p["t"] == pytest.approx(19 * h) and p["converged"]
+    assert np.abs(W - W.T).max() <= 1e-12 * np.abs(W).max()
+    assert np.linalg.eigvalsh(W).min() >= -1e-10 * np.abs(W).max()
+    assert len(blocks) == 4 and all(b["friction_rows"] == 2 and b["equality_rows"] == 0 for b in blocks)
+    assert all(b["name"] == scene.constraint_names[b["constraint"]] for b in blocks)
+    for b in blocks:
+        n = b["first"]
+        assert np.linalg.norm(P[n + 1:n + 3]) <= b["mu"] * P[n] * (1 + 1e-9)
+    load = sum(P[b["first"]] for b in blocks)
+    assert load == pytest.approx(scene.total_mass * 9.81 * h, rel=1e-3)
+    events = appell.Simulation(scene, contacts="events")
+    events.step(h)
+    assert events.contact_problem() is None

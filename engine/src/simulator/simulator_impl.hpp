@@ -136,6 +136,8 @@ struct Simulator::Impl {
   void watchEvents();
   /// Starts the Zeno and stall watches' counts afresh from the current state.
   void restartStallWatch();
+  /// The step-size part of the stall watch; true when it opened a window.
+  bool watchStepSize();
   int namedContact(const std::string& message) const;
   bool restepTo(double tau, StepStatus& st);
   /// work_ after an integrator step from the last step's start.
@@ -229,6 +231,9 @@ struct Simulator::Impl {
   long work() const { return counters_.solves + counters_.block_updates; }
   std::array<double, kStallMarks> stall_t_{};
   long stall_marks_ = 0, stall_next_ = 0, stall_low_ = 0;
+  // The step-size watch (watchStepSize): the same marks over accepted steps.
+  std::array<double, kStallMarks> step_t_{};
+  long step_marks_ = 0, step_next_ = 0;
   std::string window_reason_;
   // The start of the last step when it was time-stepped (NaN: an event
   // step, or none yet): when mj_ holds that step's contact problem.

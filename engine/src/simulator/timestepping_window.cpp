@@ -77,10 +77,11 @@ void timestepping::checkOptions(const TimeSteppingOptions& o) {
   if (!(o.theta > 0 && o.theta <= 1))
     throw std::invalid_argument("Simulator: timestepping.theta must be in (0, 1], got " +
                                 std::to_string(o.theta));
-  if (o.max_sweeps < 1 || o.zeno_events < 2 || o.stall_work < 4 /* its marks */ || o.stable_steps < 1)
+  if (o.max_sweeps < 1 || o.zeno_events < 2 || o.stall_work < 4 /* its marks */ ||
+      o.stall_steps < 4 || o.stable_steps < 1)
     throw std::invalid_argument(
-        "Simulator: timestepping.max_sweeps ≥ 1, zeno_events ≥ 2, stall_work ≥ 4 and "
-        "stable_steps ≥ 1 are required");
+        "Simulator: timestepping.max_sweeps ≥ 1, zeno_events ≥ 2, stall_work ≥ 4, stall_steps ≥ 4 "
+        "and stable_steps ≥ 1 are required");
 }
 
 bool Simulator::Impl::timeSteppingStage() {
@@ -180,6 +181,9 @@ void Simulator::Impl::restartStallWatch() {
   stall_marks_ = stall_low_ = 0;
   stall_next_ = work() + options_.timestepping.stall_work / kStallMarks;
   stall_t_.fill(t_);
+  step_marks_ = 0;
+  step_next_ = counters_.steps + options_.timestepping.stall_steps / kStallMarks;
+  step_t_.fill(t_);
 }
 
 // The Zeno and stall watches of the automatic scheme, after an event step.
@@ -215,6 +219,7 @@ void Simulator::Impl::watchEvents() {
   // slip onset: 2, 5 and 9 marks in a row at tol 1e-10, 1e-11, 1e-12). Work, not
   // evaluations: an evaluation with four sliding tyres costs a hundred times
   // one with none (docs/contacts.md §10).
+  if (watchStepSize()) return;
   if (work() < stall_next_) return;
   stall_next_ = work() + o.stall_work / kStallMarks;
   const double oldest = stall_t_[stall_marks_ % kStallMarks];
@@ -228,6 +233,30 @@ void Simulator::Impl::watchEvents() {
       << o.stall_time << " s of simulated time each (the last " << t_ - oldest
       << " s; last mode change: '" << constraints_[contact]->name() << "')";
   if (timeSteppingStage()) openWindow(contact, why.str());
+}
+
+// The step-size watch: a mark every stall_steps / kStallMarks accepted
+// steps and the simulated time at the last kStallMarks marks; the step size
+// collapsed when the last stall_steps steps advanced less than stall_time.
+// One stretch suffices (the work rule above needs eight): a single hard
+// friction problem is one step, and every example's largest burst at its
+// own tolerance, or the skid-steer's at 1e-12, is 39 steps within 1 ms
+// (docs/contacts.md §10). true when it opened a window.
+bool Simulator::Impl::watchStepSize() {
+  const TimeSteppingOptions& o = options_.timestepping;
+  if (counters_.steps < step_next_) return false;
+  step_next_ = counters_.steps + o.stall_steps / kStallMarks;
+  const double oldest = step_t_[step_marks_ % kStallMarks];
+  step_t_[step_marks_++ % kStallMarks] = t_;
+  if (step_marks_ < kStallMarks || !(t_ - oldest < o.stall_time)) return false;
+  const int contact = last_event_contact_ >= 0 ? last_event_contact_ : namedContact("");
+  std::ostringstream why;
+  why << "the step size collapsed: the last " << o.stall_steps << " steps advanced "
+      << t_ - oldest << " s of simulated time (less than " << o.stall_time
+      << " s; last mode change: '" << constraints_[contact]->name() << "')";
+  if (!timeSteppingStage()) return false;
+  openWindow(contact, why.str());
+  return true;
 }
 
 // The step's counters and its work terms (timestepping::StepWork) into the
