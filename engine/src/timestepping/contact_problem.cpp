@@ -80,6 +80,8 @@ void ContactProblem::reserve(int rows, int contacts) {
   unknown_row_.reserve(rows);
   unknown_block_.reserve(rows);
   mode_.reserve(contacts);
+  failed_modes_.reserve(contacts);
+  tried_modes_.reserve(contacts);
   dir_.resize(contacts);
   A_ = B_ = MatX::Zero(rows, rows);
   x_ = r_ = y_ = P_save_ = u_save_ = delta_ = VecX::Zero(rows);
@@ -217,6 +219,7 @@ void ContactProblem::solve(double tol, int max_sweeps) {
   converged = true;
   polished = false;
   min_norm_failed_ = false;
+  failed_modes_.clear();
   if (n == 0) return;
   start.head(n) = P.head(n);
   factorBlocks();
@@ -425,12 +428,24 @@ bool ContactProblem::solveNormalEquations() {
 // 1.7e-10), the correction nearest the iterate is tried next, and for the
 // rest of this step's sweeps alone (trying both at every finish doubled
 // cad_car's cost for the same trajectory).
+//
+// A finish that failed is not tried again until Gauss–Seidel reaches other
+// modes: from the same modes it fails again. Measured on cad_car's first
+// 3 s time-stepped (3 064 problems, 676 at the sweep limit): of 28 637
+// tries 28 416 failed, 25 921 of them from the modes of the problem's last
+// failed try, and one of those 25 921 succeeded; the retries were ~55 % of
+// the run's time.
 bool ContactProblem::polish(double tol) {
+  if (!readModes()) return false;
+  if (std::equal(mode_.begin(), mode_.end(), failed_modes_.begin(), failed_modes_.end())) return false;
+  tried_modes_.assign(mode_.begin(), mode_.end());
   if (!min_norm_failed_) {
     if (polishFrom(tol, true)) return true;
     min_norm_failed_ = true;  // (not tried again in this problem: half the finish's cost)
   }
-  return polishFrom(tol, false);
+  if (polishFrom(tol, false)) return true;
+  failed_modes_.swap(tried_modes_);
+  return false;
 }
 
 bool ContactProblem::polishFrom(double tol, bool from_zero) {

@@ -94,6 +94,9 @@ struct ContactProblem {
   bool polish(double tol);
   bool polishFrom(double tol, bool from_zero);
   bool min_norm_failed_ = false;  // this solve's minimum-norm finish missed the tolerance
+  // The modes of this solve's last failed finish (not retried from them), and
+  // of the try under way.
+  std::vector<signed char> failed_modes_, tried_modes_;
   bool readModes();
   void activeSet();
   bool solveModes(double tol, bool from_zero);
