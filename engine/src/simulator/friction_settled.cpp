@@ -76,7 +76,7 @@ constexpr double kSettledShrink = 0.1;
 /// from +∞ on (−λ₁, ∞), and φ(κ) = 1/|f(κ)| − 1/r is increasing and concave
 /// there, so Newton's method from a lower bound of the root climbs to it
 /// monotonically (Moré & Sorensen, "Computing a trust region step", 1983;
-/// as timestepping/contact_problem.cpp's diskNewton): ~5 iterations where a
+/// as friction_problem.cpp's diskMinimizer): ~5 iterations where a
 /// bisection to round-off takes ~55. The lower bound: the κ at which one
 /// component alone reaches r, maxᵢ |cᵢ|/r − λᵢ (> −λ₁).
 double upperRoot(const Vec3& lam, const Vec3& cq, int n, double r) {

@@ -28,46 +28,6 @@ Vec3 projectOntoCone(double zn, const Vec3& zf, double mu, Vec3& out_f) {
   return Vec3(a, 0, 0);
 }
 
-/// argmin ½ fᵀH f + cᵀf over |f| ≤ r (H = V diag(λ) Vᵀ, from factorDisk):
-/// the unconstrained minimum-norm minimizer when it lies inside, else
-/// f(ν) = −(H + νI)⁻¹c on the circle, ν > 0 by Newton's method on the
-/// secular equation 1/|f(ν)| = 1/r (Moré & Sorensen, "Computing a trust
-/// region step", SIAM J. Sci. Stat. Comput. 4, 1983): that function of ν
-/// is increasing and concave, so Newton from a lower bound of the root
-/// climbs to it monotonically and quadratically — ~5 iterations where the
-/// bisection of friction_problem.cpp takes ~55.
-Vec3 diskNewton(const detail::DiskFactor& H, const Vec3& c, int n, double r) {
-  if (!(r > 0)) return Vec3::Zero();
-  Vec3 cq, fq;
-  const bool bounded = detail::diskUnconstrained(H, c, n, cq, fq);
-  const Vec3& lam = H.values;
-  if (!(bounded && fq.norm() <= r)) {
-    // ν* ≥ |cq_i|/r − λ_i for each i (one component alone reaches r).
-    double nu = 0;
-    for (int i = 0; i < 3; ++i) nu = std::max(nu, std::abs(cq[i]) / r - lam[i]);
-    for (int it = 0; it < 50; ++it) {
-      double s2 = 0, ds = 0;  // |f|² and −d|f|²/dν / 2
-      for (int i = 0; i < 3; ++i) {
-        const double d = lam[i] + nu;
-        if (cq[i] == 0) continue;
-        s2 += cq[i] * cq[i] / (d * d);
-        ds += cq[i] * cq[i] / (d * d * d);
-      }
-      const double s = std::sqrt(s2);
-      if (!(s > r * (1 + 1e-15)) || !(ds > 0)) break;  // at (or, by round-off, past) the root
-      // Newton on φ(ν) = 1/s − 1/r: φ' = ds / s³.
-      const double step = (s - r) / r * s2 / ds;  // −φ/φ' = (1/r − 1/s) s³ / ds
-      if (!(step > 0)) break;
-      nu += step;
-      if (step <= 1e-15 * nu) break;
-    }
-    for (int i = 0; i < 3; ++i) fq[i] = lam[i] + nu > 0 ? -cq[i] / (lam[i] + nu) : 0.0;
-  }
-  Vec3 f = H.vectors * fq;
-  f.tail(3 - n).setZero();
-  return f;
-}
-
 }  // namespace
 
 void ContactProblem::reserve(int rows, int contacts) {
@@ -169,7 +129,7 @@ void ContactProblem::solveBlock(int j) {
   const double radius = b.mu * pn;
   const double hff = W(o + 1, o + 1);
   if (nf == 1) pf[0] = hff > 0 ? std::clamp(-cf[0] / hff, -radius, radius) : (cf[0] > 0 ? -radius : radius);
-  else pf = diskNewton(disk_[j], cf, nf, radius);
+  else pf = detail::diskMinimizer(disk_[j], cf, nf, radius);
   P[o] = pn;
   P.segment(o + 1, nf) = pf.head(nf);
 }
