@@ -104,7 +104,8 @@ TEST(ContactProblem, ColdStartCarriesTheSameLoad) {
 }
 
 // No problem to record after an event step; a problem whose blocks do not
-// tile its rows is refused with the constraint named.
+// tile its rows is refused with the constraint named, one with a NaN or a
+// start of the wrong size too.
 TEST(ContactProblem, EventStepsRecordNothingAndBadLayoutsAreRefused) {
   PushedBox box(ContactScheme::Events, 1);
   ContactProblemData d;
@@ -112,6 +113,15 @@ TEST(ContactProblem, EventStepsRecordNothingAndBadLayoutsAreRefused) {
 
   PushedBox stepped(ContactScheme::TimeStepping, 1);
   ASSERT_TRUE(stepped.sim->contactProblem(d));
+  {
+    ContactProblemData nan = d;
+    nan.W(0, 0) = std::nan("");
+    EXPECT_THROW(ContactProblemSolver{nan}, std::invalid_argument);
+    ContactProblemSolver ok(d);
+    VecX P, u;
+    EXPECT_THROW(ok.solve(VecX::Zero(d.rows() + 1), 1e-10, 100, P, u), std::invalid_argument);
+    EXPECT_THROW(ok.solve(VecX::Zero(d.rows()), 0.0, 100, P, u), std::invalid_argument);
+  }
   d.blocks[1].first += 1;
   try {
     ContactProblemSolver bad(d);

@@ -20,7 +20,7 @@ using namespace appell;
 
 namespace {
 
-constexpr double kG = 9.81, kR = 0.15;  // the car's wheel radius (examples/car)
+constexpr double kR = 0.15;  // the car's wheel radius (examples/car)
 
 struct Crossing {
   appell::test::WatchedRun run;

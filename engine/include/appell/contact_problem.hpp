@@ -61,6 +61,8 @@ class ContactProblemSolver {
     bool converged = false;  ///< residual ≤ tol · max(1, |u_free|∞)
     bool polished = false;   ///< the active-set finish ended it
   };
+  /// Throws std::invalid_argument when the blocks do not tile the rows, a
+  /// size disagrees, or a number is not finite.
   explicit ContactProblemSolver(const ContactProblemData& problem);
   ~ContactProblemSolver();
   ContactProblemSolver(ContactProblemSolver&&) noexcept;
@@ -68,6 +70,7 @@ class ContactProblemSolver {
 
   /// Solves from `start` (size n) to `tol` or `max_sweeps`; P and u = W P +
   /// u_free are the answer. Allocates nothing once P and u have n rows.
+  /// Throws std::invalid_argument for a start of another size or not finite.
   Result solve(const VecX& start, double tol, int max_sweeps, VecX& P, VecX& u);
   /// The natural-map residual of impulses P (the solver's stopping measure).
   double residual(const VecX& P);

@@ -33,6 +33,14 @@ void checkLayout(const ContactProblemData& d) {
   }
   if (at != n || d.W.rows() != n || d.W.cols() != n || d.target.size() != n)
     throw std::invalid_argument("ContactProblemSolver: W, u_free, target and the blocks' rows disagree in size");
+  if (!d.W.allFinite() || !d.u_free.allFinite() || !d.target.allFinite())
+    throw std::invalid_argument("ContactProblemSolver: W, u_free and target must be finite");
+}
+
+void checkStart(const VecX& start, int n) {
+  if (start.size() != n || !start.allFinite())
+    throw std::invalid_argument("ContactProblemSolver: the start (or impulses) must be " + std::to_string(n) +
+                                " finite numbers, got " + std::to_string(start.size()));
 }
 
 }  // namespace
@@ -55,6 +63,9 @@ ContactProblemSolver& ContactProblemSolver::operator=(ContactProblemSolver&&) no
 ContactProblemSolver::Result ContactProblemSolver::solve(const VecX& start, double tol,
                                                          int max_sweeps, VecX& P, VecX& u) {
   timestepping::ContactProblem& p = impl_->problem;
+  checkStart(start, p.n);
+  if (!(tol > 0) || max_sweeps < 1)
+    throw std::invalid_argument("ContactProblemSolver: tol > 0 and max_sweeps ≥ 1 are required");
   p.P.head(p.n) = start;
   p.solve(tol, max_sweeps);
   P = p.P.head(p.n);
@@ -64,6 +75,7 @@ ContactProblemSolver::Result ContactProblemSolver::solve(const VecX& start, doub
 
 double ContactProblemSolver::residual(const VecX& P) {
   timestepping::ContactProblem& p = impl_->problem;
+  checkStart(P, p.n);
   p.P.head(p.n) = P;
   p.u.head(p.n) = p.u_free.head(p.n);
   p.u.head(p.n).noalias() += p.W.topLeftCorner(p.n, p.n) * P;
