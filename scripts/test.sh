@@ -11,9 +11,10 @@
 #                             link, the last tests). The benchmarks are not built
 #                             here: scripts/bench.sh builds and runs them.
 #   scripts/test.sh --quick   the fast local loop: the C++ tests only, in their own
-#                             build (build-quick: clang, -O1, no Python, viewer
-#                             or sanitizers); SANITIZE=0 keeps the Release suite
-#                             and skips only the sanitized part.
+#                             build (build-quick: clang, -O1, no Python, browser
+#                             or sanitizers; three.js for `appell view` is
+#                             installed, its tests need it); SANITIZE=0 keeps the
+#                             Release suite and skips only the sanitized part.
 # Extra arguments go to ctest (e.g. -R Friction). Times on 2 cores, and why
 # the builds are compiled with clang: README.md, "Building".
 set -euo pipefail
@@ -29,6 +30,9 @@ prefer_clang() {
 }
 if [ "${1:-}" = "--quick" ]; then
   shift
+  # three.js, which `appell view` embeds and its C++ tests (CliPlot.View*)
+  # open; not the browser (the screenshot test is not in this loop).
+  bash scripts/install-viewer-deps.sh
   prefer_clang build-quick
   cmake -S . -B build-quick -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" -DAPPELL_BUILD_BENCHMARKS=OFF \
