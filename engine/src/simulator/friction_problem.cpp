@@ -19,11 +19,7 @@ using detail::UnilateralRow;
 /// argmin ½ fᵀH f + cᵀf over |f| ≤ r in the first n (≤ 3) components, H
 /// symmetric positive semidefinite: the unconstrained (minimum-norm)
 /// minimizer when it lies inside, else f = −(H + νI)⁻¹c with ν > 0 on the
-/// circle, by Newton's method on the secular equation 1/|f(ν)| = 1/r (Moré &
-/// Sorensen, "Computing a trust region step", SIAM J. Sci. Stat. Comput. 4,
-/// 1983): that function of ν is increasing and concave, so Newton from a
-/// lower bound of the root climbs to it monotonically and quadratically —
-/// ~5 iterations where a bisection to round-off takes ~55.
+/// circle (secularRoot).
 Vec3 detail::diskMinimizer(const Mat3& H, const Vec3& c, int n, double r) {
   if (!(r > 0)) return Vec3::Zero();
   return diskMinimizer(factorDisk(H, n), c, n, r);
@@ -66,29 +62,33 @@ Vec3 detail::diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r) 
     f.tail(3 - n).setZero();
     return f;
   }
-  // ν* ≥ |cq_i|/r − λ_i for each i (one component alone reaches r).
-  double nu = 0;
-  for (int i = 0; i < 3; ++i) nu = std::max(nu, std::abs(cq[i]) / r - lam[i]);
+  const double nu = secularRoot(lam, cq, r, 0.0);
+  for (int i = 0; i < 3; ++i) fq[i] = lam[i] + nu > 0 ? -cq[i] / (lam[i] + nu) : 0.0;
+  Vec3 f = H.vectors * fq;
+  f.tail(3 - n).setZero();
+  return f;
+}
+
+double detail::secularRoot(const Vec3& lam, const Vec3& cq, double r, double lower) {
+  double x = lower;  // (a component alone reaches r at |cᵢ|/r − λᵢ: the root is above)
+  for (int i = 0; i < 3; ++i)
+    if (cq[i] != 0) x = std::max(x, std::abs(cq[i]) / r - lam[i]);
   for (int it = 0; it < 50; ++it) {
-    double s2 = 0, ds = 0;  // |f|² and −d|f|²/dν / 2
+    double s2 = 0, ds = 0;  // |f|² and −d|f|²/dx / 2
     for (int i = 0; i < 3; ++i) {
-      const double d = lam[i] + nu;
       if (cq[i] == 0) continue;
+      const double d = lam[i] + x;
       s2 += cq[i] * cq[i] / (d * d);
       ds += cq[i] * cq[i] / (d * d * d);
     }
     const double s = std::sqrt(s2);
     if (!(s > r * (1 + 1e-15)) || !(ds > 0)) break;  // at (or, by round-off, past) the root
-    // Newton on φ(ν) = 1/s − 1/r: φ' = ds / s³.
-    const double step = (s - r) / r * s2 / ds;  // −φ/φ' = (1/r − 1/s) s³ / ds
+    const double step = (s - r) / r * s2 / ds;       // −φ/φ' = (1/r − 1/s) s³ / ds
     if (!(step > 0)) break;
-    nu += step;
-    if (step <= 1e-15 * nu) break;
+    x += step;
+    if (step <= 1e-15 * std::abs(x)) break;
   }
-  for (int i = 0; i < 3; ++i) fq[i] = lam[i] + nu > 0 ? -cq[i] / (lam[i] + nu) : 0.0;
-  Vec3 f = H.vectors * fq;
-  f.tail(3 - n).setZero();
-  return f;
+  return x;
 }
 
 /// Column first + i of p.U: the generalized force of a unit force along

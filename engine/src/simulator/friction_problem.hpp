@@ -91,8 +91,17 @@ Vec3 diskMinimizer(const DiskFactor& H, const Vec3& c, int n, double r);
 /// The disk problem without its disk, in H's eigenbasis: cq = Vᵀc (c past n
 /// zero) and fq the minimum-norm unconstrained minimizer (zero along H's
 /// null directions). false when c has a part in that null space: no finite
-/// minimizer, the answer is on the circle. Shared by diskMinimizer and the
-/// time-stepping solver's Newton version (timestepping/contact_problem.cpp).
+/// minimizer, the answer is on the circle. diskMinimizer's first part.
 bool diskUnconstrained(const DiskFactor& H, const Vec3& c, int n, Vec3& cq, Vec3& fq);
+/// The root x ≥ `lower` of the secular equation |f(x)| = r, fᵢ = −cᵢ/(λᵢ + x)
+/// (components with cᵢ = 0 left out), for x above −λᵢ of every cᵢ ≠ 0 —
+/// the multiplier of a disk's minimizer on its circle (diskMinimizer, lower
+/// 0) and of a settled slip direction (friction_settled.cpp, lower −λ₁).
+/// φ(x) = 1/|f(x)| − 1/r is increasing and concave there, so Newton's method
+/// from a lower bound of the root climbs to it monotonically and
+/// quadratically (Moré & Sorensen, "Computing a trust region step", SIAM J.
+/// Sci. Stat. Comput. 4, 1983): ~5 iterations where a bisection to round-off
+/// takes ~55. The start: `lower`, or where one component alone reaches r.
+double secularRoot(const Vec3& lam, const Vec3& cq, double r, double lower);
 
 }  // namespace appell::detail

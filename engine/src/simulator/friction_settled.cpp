@@ -72,33 +72,6 @@ namespace {
 /// relaxation rate for a shrinking settled direction to be taken.
 constexpr double kSettledShrink = 0.1;
 
-/// The root κ > −λ₁ of |f(κ)| = r, fᵢ = −cᵢ/(λᵢ + κ) (c₁ ≠ 0): |f| decreases
-/// from +∞ on (−λ₁, ∞), and φ(κ) = 1/|f(κ)| − 1/r is increasing and concave
-/// there, so Newton's method from a lower bound of the root climbs to it
-/// monotonically (Moré & Sorensen, "Computing a trust region step", 1983;
-/// as friction_problem.cpp's diskMinimizer): ~5 iterations where a
-/// bisection to round-off takes ~55. The lower bound: the κ at which one
-/// component alone reaches r, maxᵢ |cᵢ|/r − λᵢ (> −λ₁).
-double upperRoot(const Vec3& lam, const Vec3& cq, int n, double r) {
-  double kappa = -lam[0];
-  for (int i = 0; i < n; ++i) kappa = std::max(kappa, std::abs(cq[i]) / r - lam[i]);
-  for (int it = 0; it < 50; ++it) {
-    double s2 = 0, ds = 0;  // |f|² and −d|f|²/dκ / 2
-    for (int i = 0; i < n; ++i) {
-      const double d = lam[i] + kappa;
-      s2 += cq[i] * cq[i] / (d * d);
-      ds += cq[i] * cq[i] / (d * d * d);
-    }
-    const double s = std::sqrt(s2);
-    if (!(s > r * (1 + 1e-15)) || !(ds > 0)) break;  // at the root (or past it by round-off)
-    const double step = (s - r) / r * s2 / ds;       // −φ/φ′
-    if (!(step > 0)) break;
-    kappa += step;
-    if (step <= 1e-16 * std::abs(kappa)) break;
-  }
-  return kappa;
-}
-
 bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& side, Vec3& f) {
   Mat3 Hp = Mat3::Zero();
   Hp.topLeftCorner(n, n) = H.topLeftCorner(n, n);
@@ -129,7 +102,8 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
     out.tail(3 - n).setZero();
     return out;
   };
-  double b = upperRoot(lam, cq, n, r), a;
+  // The upper root, κ > −λ₁ (|f| decreases from +∞ there).
+  double b = detail::secularRoot(lam, cq, r, -lam[0]), a;
   // A growing slip (κ ≥ 0) keeps its direction while it relaxes onto this
   // one; a shrinking one may stop first — a slip that its own friction
   // brakes about as fast as it turns it ends in a stick event, and its
