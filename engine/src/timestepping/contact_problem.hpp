@@ -97,6 +97,7 @@ struct ContactProblem {
   // The modes of this solve's last failed finish (not retried from them), and
   // of the try under way.
   std::vector<signed char> failed_modes_, tried_modes_;
+  bool opened_least_ = false;  ///< this finish opened its least loaded block
   bool readModes();
   void activeSet();
   bool solveModes(double tol, bool from_zero);
