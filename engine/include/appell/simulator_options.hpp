@@ -53,11 +53,12 @@ struct TimeSteppingOptions {
   double stall_time = 1e-3;
   /// … or when the last stall_steps accepted event steps advanced the
   /// simulated time by less than stall_time (checked every stall_steps/4
-  /// steps): the step size collapsed — a mean step of 2 µs at the defaults,
-  /// where every example's largest burst is 39 steps in 1 ms (docs/contacts.md
-  /// §10). Cheap steps that stall (a box's four corners at their slip onset)
-  /// are caught here long before their work reaches the rule above.
-  long stall_steps = 500;
+  /// steps): the step size collapsed — a mean step below 7.8 µs at the
+  /// defaults, where every example's largest burst is 39 steps in 1 ms and
+  /// the stalls run at 200 and more (docs/contacts.md §10). Cheap steps that
+  /// stall (a box's four corners at their slip onset) are caught here long
+  /// before their work reaches the rule above.
+  long stall_steps = 128;
   // … and when it ends: at least min_window (s, doubled each time the events
   // fail again within a window's length of its end), the contact modes
   // unchanged over stable_steps steps, and the event scheme's modes decided.

@@ -240,8 +240,9 @@ void Simulator::Impl::watchEvents() {
 // collapsed when the last stall_steps steps advanced less than stall_time.
 // One stretch suffices (the work rule above needs eight): a single hard
 // friction problem is one step, and every example's largest burst at its
-// own tolerance, or the skid-steer's at 1e-12, is 39 steps within 1 ms
-// (docs/contacts.md §10). true when it opened a window.
+// own tolerance, or the skid-steer's at 1e-12, is 39 steps within 1 ms,
+// cad_car's stall at its steering step 206 (docs/contacts.md §10: why
+// 128). true when it opened a window.
 bool Simulator::Impl::watchStepSize() {
   const TimeSteppingOptions& o = options_.timestepping;
   if (counters_.steps < step_next_) return false;
