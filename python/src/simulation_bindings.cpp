@@ -341,6 +341,7 @@ void bindSimulation(py::module_& m) {
                                  "mu"_a = b.mu));
         return py::dict("t"_a = d.t, "W"_a = d.W, "u_free"_a = d.u_free, "target"_a = d.target,
                         "warm_start"_a = d.warm_start, "P"_a = d.P, "blocks"_a = blocks,
+                        "skipped_finish_modes"_a = d.skipped_finish_modes,
                         "sweeps"_a = d.sweeps, "residual"_a = d.residual, "converged"_a = d.converged);
       }, "The last step's contact problem u = W P + u_free (docs/contacts.md §10) as a dict, "
          "None when that step was not time-stepped or had no contact candidate.")

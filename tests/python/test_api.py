@@ -311,6 +311,10 @@ def test_a_time_stepped_steps_contact_problem_carries_the_weight_within_its_cone
         assert np.linalg.norm(P[n + 1:n + 3]) <= b["mu"] * P[n] * (1 + 1e-9)
     load = sum(P[b["first"]] for b in blocks)
     assert load == pytest.approx(scene.total_mass * 9.81 * h, rel=1e-3)
+    # Finish modes the step skipped (an earlier step's failed finish): none,
+    # or one mode (0 open, 1 pushing, 2 sliding) per block.
+    skipped = p["skipped_finish_modes"]
+    assert len(skipped) in (0, len(blocks)) and all(m in (0, 1, 2) for m in skipped)
     events = appell.Simulation(scene, contacts="events")
     events.step(h)
     assert events.contact_problem() is None

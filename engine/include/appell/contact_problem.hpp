@@ -44,6 +44,11 @@ struct ContactProblemData {
   MatX W;                       ///< n × n, symmetric positive semidefinite
   VecX u_free, target;          ///< n each
   VecX warm_start;              ///< the impulses the solve started from
+  /// Per block, the modes (0 open, 1 pushing, 2 sliding) from which the
+  /// step did not try the active-set finish: those of an earlier step's
+  /// failed finish over the same contacts (docs/contacts.md §10); empty
+  /// when it skipped none. ContactProblemSolver skips them too.
+  std::vector<int> skipped_finish_modes;
   VecX P;                       ///< the step's impulses (N s)
   std::vector<ContactProblemBlock> blocks;
   int sweeps = 0;               ///< Gauss–Seidel sweeps the step took
@@ -62,7 +67,8 @@ class ContactProblemSolver {
     bool polished = false;   ///< the active-set finish ended it
   };
   /// Throws std::invalid_argument when the blocks do not tile the rows, a
-  /// size disagrees, or a number is not finite.
+  /// size disagrees, a number is not finite, or skipped_finish_modes is
+  /// neither empty nor one mode in {0, 1, 2} per block.
   explicit ContactProblemSolver(const ContactProblemData& problem);
   ~ContactProblemSolver();
   ContactProblemSolver(ContactProblemSolver&&) noexcept;

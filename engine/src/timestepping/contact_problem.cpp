@@ -41,6 +41,7 @@ void ContactProblem::reserve(int rows, int contacts) {
   unknown_block_.reserve(rows);
   mode_.reserve(contacts);
   failed_modes_.reserve(contacts);
+  skip_modes.reserve(contacts);
   tried_modes_.reserve(contacts);
   dir_.resize(contacts);
   A_ = B_ = MatX::Zero(rows, rows);
@@ -179,7 +180,8 @@ void ContactProblem::solve(double tol, int max_sweeps) {
   converged = true;
   polished = false;
   min_norm_failed_ = false;
-  failed_modes_.clear();
+  failed_finishes_ = 0;
+  failed_modes_.assign(skip_modes.begin(), skip_modes.end());
   if (n == 0) return;
   start.head(n) = P.head(n);
   factorBlocks();
@@ -390,7 +392,9 @@ bool ContactProblem::solveNormalEquations() {
 // cad_car's cost for the same trajectory).
 //
 // A finish that failed is not tried again until Gauss–Seidel reaches other
-// modes: from the same modes it fails again. Measured on cad_car's first
+// modes: from the same modes it fails again. The caller may carry a failed
+// finish's modes into the next problems over the same contacts (skip_modes;
+// MoreauJean::solveProblem). Measured on cad_car's first
 // 3 s time-stepped (3 064 problems, 676 at the sweep limit): of 28 637
 // tries 28 416 failed, 25 921 of them from the modes of the problem's last
 // failed try, and one of those 25 921 succeeded; the retries were ~55 % of
@@ -405,6 +409,7 @@ bool ContactProblem::polish(double tol) {
   }
   if (polishFrom(tol, false)) return true;
   failed_modes_.swap(tried_modes_);
+  ++failed_finishes_;
   return false;
 }
 

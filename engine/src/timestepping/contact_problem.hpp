@@ -70,6 +70,11 @@ struct ContactProblem {
   double residual = 0;
   bool converged = true;
   bool polished = false;  ///< the active-set finish solved it
+  /// Modes (per block: 0 open, 1 pushing, 2 sliding) from which solve() does
+  /// not try the active-set finish — an earlier solve's failed finish over
+  /// the same blocks, carried by the caller (MoreauJean::carryFailedFinish).
+  /// Empty: none.
+  std::vector<signed char> skip_modes;
 
   /// Sizes everything for at most `rows` rows in `contacts` blocks.
   void reserve(int rows, int contacts);
@@ -84,6 +89,11 @@ struct ContactProblem {
   void solve(double tol, int max_sweeps);
   /// The block's natural-map residual at the current P and u (m/s).
   double blockResidual(const ProblemBlock& b) const;
+  /// After solve(): the modes of its last failed finish (skip_modes when it
+  /// tried none but skipped those; empty when none failed), and how many
+  /// finishes it tried that failed.
+  const std::vector<signed char>& failedModes() const { return failed_modes_; }
+  int failedFinishes() const { return failed_finishes_; }
 
  private:
   using Mat6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
@@ -98,6 +108,7 @@ struct ContactProblem {
   // of the try under way.
   std::vector<signed char> failed_modes_, tried_modes_;
   bool opened_least_ = false;  ///< this finish opened its least loaded block
+  int failed_finishes_ = 0;    ///< finishes this solve tried that failed
   bool readModes();
   void activeSet();
   bool solveModes(double tol, bool from_zero);

@@ -1,8 +1,8 @@
 // ContactProblemSolver (appell/contact_problem.hpp): the time-stepping
 // scheme's own contact-problem solver (contact_problem.hpp) over a problem
 // given as data — the same Gauss–Seidel and active-set finish, so a
-// recorded step's problem re-solved from its warm start gives its impulses
-// bit for bit.
+// recorded step's problem re-solved from its warm start (and with the
+// finish modes the step skipped) gives its impulses bit for bit.
 #include <appell/contact_problem.hpp>
 
 #include "timestepping/contact_problem.hpp"
@@ -35,6 +35,13 @@ void checkLayout(const ContactProblemData& d) {
     throw std::invalid_argument("ContactProblemSolver: W, u_free, target and the blocks' rows disagree in size");
   if (!d.W.allFinite() || !d.u_free.allFinite() || !d.target.allFinite())
     throw std::invalid_argument("ContactProblemSolver: W, u_free and target must be finite");
+  const auto& skip = d.skipped_finish_modes;
+  if ((!skip.empty() && skip.size() != d.blocks.size()) ||
+      std::any_of(skip.begin(), skip.end(), [](int m) { return m < 0 || m > 2; }))
+    throw std::invalid_argument("ContactProblemSolver: skipped_finish_modes must be empty or one mode "
+                                "(0 open, 1 pushing, 2 sliding) per block; got " +
+                                std::to_string(skip.size()) + " for " + std::to_string(d.blocks.size()) +
+                                " blocks");
 }
 
 void checkStart(const VecX& start, int n) {
@@ -54,6 +61,7 @@ ContactProblemSolver::ContactProblemSolver(const ContactProblemData& d)
   p.W.topLeftCorner(p.n, p.n) = d.W;
   p.u_free.head(p.n) = d.u_free;
   p.target.head(p.n) = d.target;
+  p.skip_modes.assign(d.skipped_finish_modes.begin(), d.skipped_finish_modes.end());
 }
 
 ContactProblemSolver::~ContactProblemSolver() = default;

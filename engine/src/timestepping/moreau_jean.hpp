@@ -128,6 +128,7 @@ class MoreauJean {
   bool solveWithServos(const Model& model, Data& data, const ConstraintList& constraints,
                        ConstraintData& cdata, ConstrainedSolver& solver, int n);
   void finish(const ConstraintData& cdata, const VecX& v0, const VecX& v1, double h);
+  void solveProblem();
 
   TimeSteppingOptions options_;
   double gap_tol_;
@@ -143,6 +144,12 @@ class MoreauJean {
   std::vector<int> map_;           ///< per problem row: its row in the Delassus J
   int rows_ = 0;                   ///< rows of every candidate (J's layout)
   ContactProblem problem_;
+  // The last failed active-set finish, carried from solve to solve over the
+  // same blocks (solveProblem): its modes, the blocks' constraints, and the
+  // solves since it was last tried.
+  std::vector<signed char> carry_modes_;
+  std::vector<int> carry_ids_, ids_;
+  int carry_age_ = 0;
   ImplicitServos servos_;
   MatX W_all_;                     ///< the Delassus operator over problem and servo rows
   MatX Rs_, Wss_;                  ///< the servos' responses and their block, at the step's q
