@@ -48,6 +48,7 @@
 
 #include <Eigen/Cholesky>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -141,20 +142,32 @@ struct Delassus {
   MatX A;          ///< 6 × nv: one constraint's rows (scratch)
   MatX body_J;     ///< 6 × nv scratch
   VecX abias, tau;
+  // The mass-matrix path (respond): M and its Cholesky factor, in a Data of
+  // their own so that the scene's kinematics caches stay as the solver left them.
+  std::unique_ptr<Data> mass_data;
+  Eigen::LLT<MatX> mass_llt;
 
-  void reserve(int nv, int rows);
+  void reserve(const Model& model, int rows);
   /// Writes `count` rows `rows` of constraint `c` (as evaluated in `cdata`)
   /// to J and b from row `at`. `data` as evaluateConstraintRows leaves it.
   void assemble(const Model& model, const Data& data, const ConstraintList& constraints,
                 const ConstraintData& cdata, int c, const int* rows, int count, int at);
   /// R's columns for the problem rows `map` (indices into J) and W = J R:
   /// one solve of `solver` per row at τ + s Jᵢᵀ, less the free one (v̇₀),
-  /// over s (the map is affine in τ). false with `error` when a solve fails.
-  /// with_W false: R's columns only.
+  /// over s (the map is affine in τ) — or, when no row is closed (no
+  /// bilateral constraint: then R = M⁻¹Jᵀ), from one Cholesky factor of M.
+  /// false with `error` when a solve fails. with_W false: R's columns only.
   bool respond(const Model& model, Data& data, const ConstraintList& constraints,
                ConstraintData& cdata, ConstrainedSolver& solver, const VecX& q, const VecX& v,
                const VecX& tau, const VecX& vdot0, const std::vector<int>& map, int n,
                ConstrainedResult& res, MatX& W, std::string& error, bool with_W = true);
+
+ private:
+  bool solvedResponses(const Model& model, Data& data, const ConstraintList& constraints,
+                       ConstraintData& cdata, ConstrainedSolver& solver, const VecX& q,
+                       const VecX& v, const VecX& tau0, const VecX& vdot0,
+                       const std::vector<int>& map, int n, ConstrainedResult& res,
+                       std::string& error);
 };
 
 }  // namespace appell::timestepping

@@ -65,7 +65,7 @@ MoreauJean::MoreauJean(const Model& model, const ConstraintList& constraints,
   servos_ = ImplicitServos(model, std::move(servos), rows);
   const int ns = servos_.size();
   // The servo rows follow the contacts' in J: the coordinate itself, u = v_d.
-  delassus_.reserve(model.nv, rows + ns);
+  delassus_.reserve(model, rows + ns);
   for (int i = 0; i < ns; ++i) delassus_.J(rows + i, servos_.dof(i)) = 1;
   map_.reserve(rows + ns);
   if (ns > 0) W_all_ = MatX::Zero(rows + ns, rows + ns);
