@@ -73,7 +73,7 @@ struct ContactProblem {
   bool polished = false;  ///< the active-set finish solved it
   /// Modes (per block: 0 open, 1 pushing, 2 sliding) from which solve() does
   /// not try the active-set finish — an earlier solve's failed finish over
-  /// the same blocks, carried by the caller (MoreauJean::carryFailedFinish).
+  /// the same blocks, carried by the caller (MoreauJean::solveProblem).
   /// Empty: none.
   std::vector<signed char> skip_modes;
 
