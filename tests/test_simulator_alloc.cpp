@@ -354,9 +354,9 @@ TEST(SimulatorAllocation, FrictionEventsDoNotAllocate) {
 }
 
 // A time-stepping step (timestepping/moreau_jean.cpp: the free motion, the
-// Delassus operator by unit-impulse solves, the Gauss–Seidel contact problem
-// and its finish) allocates nothing either: its buffers are sized when the
-// stage is built. A ball launched sliding at 1 m/s sticks after
+// Delassus operator — here from the mass matrix, no row being closed —, the
+// Gauss–Seidel contact problem and its finish) allocates nothing either: its
+// buffers are sized when the stage is built. A ball launched sliding at 1 m/s sticks after
 // 2v₀/(7μg) ≈ 0.097 s and is pushed from 0.2 s until it slips again — every
 // mode a contact takes in a window (slide, stick, slide), in each solver.
 TEST(SimulatorAllocation, TimeSteppingStepsDoNotAllocate) {
@@ -389,6 +389,38 @@ TEST(SimulatorAllocation, TimeSteppingStepsDoNotAllocate) {
     EXPECT_GT(sticking_steps, 100) << "solver " << which;
     EXPECT_EQ(allocations, 0) << "solver " << which;
   }
+}
+
+// The other Delassus path, one solve of the scene's solver per row, where
+// rows stay closed for the step (timestepping/delassus.cpp): the steered car
+// (examples/steered_car), whose knuckles follow its hand wheel through two
+// mimic couplings — bilateral rows — time-stepped with its servos for 0.3 s
+// on its four tyres, allocates nothing either.
+TEST(SimulatorAllocation, TimeSteppingWithBilateralRowsDoesNotAllocate) {
+  const Scene s = loadScene(std::string(APPELL_SOURCE_DIR) + "/examples/steered_car/steered_car.urdf");
+  RunOptions o = runOptions(s.settings);
+  o.contacts = ContactScheme::TimeStepping;
+  const auto sim = makeSimulator(s, o);
+  ASSERT_GT(sim->constraintData().m_active, 0) << "the mimic rows are closed";
+  long allocations = 0, closed_steps = 0;
+  while (sim->time() < 0.3) {
+    StepStatus st;
+    {
+      Arm arm;
+      st = sim->step(1e-3);
+      allocations += g_allocations;
+    }
+    ASSERT_TRUE(st.ok) << st.message;
+    int closed = 0;
+    for (int c = 0; c < static_cast<int>(sim->constraints().size()); ++c) {
+      const std::string& name = sim->constraints()[c]->name();
+      closed += (name == "fl" || name == "fr" || name == "rl" || name == "rr") && sim->isClosed(c);
+    }
+    closed_steps += closed == 4;
+  }
+  EXPECT_EQ(sim->counters().timestepping_steps, sim->counters().steps);
+  EXPECT_GT(closed_steps, 250) << "on its four tyres";
+  EXPECT_EQ(allocations, 0);
 }
 
 // Servos in time-stepping (timestepping/implicit_servos.cpp) allocate

@@ -465,7 +465,7 @@ void MoreauJean::solveProblem() {
   if (failed.empty() || !problem_.converged) {
     carry_modes_.clear();
     carry_ids_.clear();
-  } else if (problem_.failedFinishes() > 0 || !same) {
+  } else if (problem_.failedFinishes() > 0) {  // (a failure of its own: carried afresh)
     carry_modes_.assign(failed.begin(), failed.end());
     carry_ids_.assign(ids_.begin(), ids_.end());
     carry_age_ = 0;
