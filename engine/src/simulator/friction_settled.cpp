@@ -72,22 +72,57 @@ namespace {
 /// relaxation rate for a shrinking settled direction to be taken.
 constexpr double kSettledShrink = 0.1;
 
-bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& side, Vec3& f) {
+}  // namespace
+
+/// H's n eigenpairs as settledForce uses them (H's n × n block padded with
+/// zeros; the padding's eigenvalues left out, ascending). H is fixed over
+/// one island's sweeps: factored once, at its candidate's first use.
+detail::SettleFactor detail::settleFactor(const Mat3& H, int n) {
   Mat3 Hp = Mat3::Zero();
   Hp.topLeftCorner(n, n) = H.topLeftCorner(n, n);
   Eigen::SelfAdjointEigenSolver<Mat3> es(Hp);
   // The padded zero block's eigenvalues sit beside the real ones: keep the n
   // whose eigenvectors lie in the first n components (ascending).
-  Vec3 lam = Vec3::Zero(), cq = Vec3::Zero();
-  Mat3 E = Mat3::Zero();
-  int m = 0;
-  for (int i = 0; i < 3 && m < n; ++i) {
+  SettleFactor out;
+  for (int i = 0; i < 3 && out.m < n; ++i) {
     if (es.eigenvectors().col(i).head(n).norm() < 0.5) continue;
-    lam[m] = std::max(es.eigenvalues()[i], 0.0);
-    E.col(m) = es.eigenvectors().col(i);
-    cq[m] = E.col(m).dot(c);
-    ++m;
+    out.lam[out.m] = std::max(es.eigenvalues()[i], 0.0);
+    out.E.col(out.m) = es.eigenvectors().col(i);
+    ++out.m;
   }
+  return out;
+}
+
+namespace {
+
+/// The root of g, increasing on (a, b) with g < 0 left of the root and
+/// g ≥ 0 right of it: Newton's steps, a step that leaves the bracket
+/// replaced by its midpoint (a safeguarded Newton method, "rtsafe" in Press
+/// et al., Numerical Recipes, 3rd ed. 2007, §9.4), from x, to round-off —
+/// ~5 evaluations where bisection took ~55. g(x, value, slope).
+template <class G>
+double bracketedRoot(double a, double b, double x, G&& g) {
+  if (!(x > a && x < b)) x = 0.5 * (a + b);
+  for (int it = 0; it < 200 && b - a > 1e-16 * (std::abs(a) + std::abs(b)); ++it) {
+    double v, dv;
+    g(x, v, dv);
+    if (v == 0) return x;
+    (v < 0 ? a : b) = x;
+    const double step = v / dv;
+    if (std::abs(step) <= 4e-16 * std::abs(x)) return x - step;  // (round-off reached)
+    x -= step;
+    if (!(x > a && x < b)) x = 0.5 * (a + b);
+  }
+  return x;
+}
+
+bool settledForce(const detail::SettleFactor& fac, const Mat3& H, const Vec3& c, int n, double r,
+                  const Vec3& side, Vec3& f) {
+  const Vec3& lam = fac.lam;
+  const Mat3& E = fac.E;
+  const int m = fac.m;
+  Vec3 cq = Vec3::Zero();
+  for (int i = 0; i < m; ++i) cq[i] = E.col(i).dot(c);
   const double cn = cq.norm();  // (its components past n are zero)
   if (m != n || !(r > 0) || !(std::abs(cq[0]) > 1e-14 * cn)) return false;
   auto norm2 = [&](double kappa) {
@@ -103,7 +138,8 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
     return out;
   };
   // The upper root, κ > −λ₁ (|f| decreases from +∞ there).
-  double b = detail::secularRoot(lam, cq, r, -lam[0]), a;
+  const double b = detail::secularRoot(lam, cq, r, -lam[0]);
+  double a;
   // A growing slip (κ ≥ 0) keeps its direction while it relaxes onto this
   // one; a shrinking one may stop first — a slip that its own friction
   // brakes about as fast as it turns it ends in a stick event, and its
@@ -123,28 +159,39 @@ bool settledForce(const Mat3& H, const Vec3& c, int n, double r, const Vec3& sid
   double lo = n > 1 ? -lam[1] : hi - 2 * cn / r;
   if (!(lo < hi)) return false;
   a = lo;
-  b = hi;
-  if (n > 1) {  // the minimum: d|f|²/dκ = −2 Σ cᵢ²/(λᵢ + κ)³ increases
-    auto slope = [&](double kappa) {
-      double s = 0;
-      for (int i = 0; i < n; ++i) {
-        const double d = lam[i] + kappa;
-        s -= cq[i] * cq[i] / (d * d * d);
-      }
-      return s;
-    };
-    for (int it = 0; it < 200 && b - a > 1e-16 * (std::abs(a) + std::abs(b)); ++it) {
-      const double mid = 0.5 * (a + b);
-      (slope(mid) < 0 ? a : b) = mid;
+  if (n > 1) {
+    // The minimum: d|f|²/dκ = −2 Σ cᵢ²/dᵢ³ (dᵢ = λᵢ + κ) vanishes. With two
+    // rows, d₁ < 0 < d₂, where c₁²/|d₁|³ = c₂²/d₂³ and |d₁| + d₂ = λ₂ − λ₁:
+    // d₂ = (λ₂ − λ₁)/(1 + (|c₁|/|c₂|)^⅔). With three, the increasing slope's root.
+    if (n == 2) {
+      a = cq[1] == 0 ? lo : (lam[1] - lam[0]) / (1 + std::cbrt(cq[0] * cq[0] / (cq[1] * cq[1]))) - lam[1];
+      a = std::clamp(a, lo, hi);
+    } else {
+      a = bracketedRoot(lo, hi, 0.5 * (lo + hi), [&](double kappa, double& s, double& ds) {
+        s = ds = 0;
+        for (int i = 0; i < n; ++i) {
+          const double d = lam[i] + kappa, c2 = cq[i] * cq[i];
+          s -= c2 / (d * d * d);
+          ds += 3 * c2 / (d * d * d * d);
+        }
+      });
     }
-    a = 0.5 * (a + b);
     if (!(norm2(a) <= r * r)) return false;
-    b = hi;
   }
-  for (int it = 0; it < 200 && b - a > 1e-16 * (std::abs(a) + std::abs(b)); ++it) {
-    const double mid = 0.5 * (a + b);
-    (norm2(mid) < r * r ? a : b) = mid;
-  }
+  // |f| = r right of it, where |f| grows to ∞ at −λ₁: Newton's method on
+  // 1/r − 1/|f|, nearly linear there (1/|f| ≈ |d₁|/|c₁| near the pole),
+  // from where the first component alone reaches r.
+  a = bracketedRoot(a, hi, hi - std::abs(cq[0]) / r, [&](double kappa, double& g, double& dg) {
+    double f2 = 0, df2 = 0;  // |f|² and its derivative
+    for (int i = 0; i < n; ++i) {
+      const double d = lam[i] + kappa, c2 = cq[i] * cq[i];
+      f2 += c2 / (d * d);
+      df2 -= 2 * c2 / (d * d * d);
+    }
+    const double fn = std::sqrt(f2);
+    g = 1 / r - 1 / fn;
+    dg = 0.5 * df2 / (f2 * fn);
+  });
   f = force(a);
   return f.allFinite() && -f.dot(side) > 0 && slowly(a);
 }
@@ -170,7 +217,11 @@ double Simulator::Impl::settleCandidate(std::span<const int> run, int j, int F) 
     p.disk(o0, n, F, H, c);
     // The stable settled direction on the slip's own side.
     detail::slipDirection(*cdata_, r, floor);
-    if (!settledForce(H, c, n, radius, r.dir, fj)) fj.setZero();  // along its slip (below)
+    if (!u.settle_factored[j]) {
+      u.settle_factor[j] = detail::settleFactor(H, n);
+      u.settle_factored[j] = 1;
+    }
+    if (!settledForce(u.settle_factor[j], H, c, n, radius, r.dir, fj)) fj.setZero();  // along its slip (below)
   }
   if (!(fj.norm() >= (1 - 1e-9) * radius) || radius == 0) {
     detail::slipDirection(*cdata_, r, floor);
@@ -227,6 +278,7 @@ bool Simulator::Impl::settleIsland(double t, const VecX& q, const VecX& v, const
   // sweeps. A candidate slow to settle, or whose minimizer is inside its
   // circle, slides along its slip (its force then known, still affine in
   // its load).
+  std::fill_n(u.settle_factored.begin(), K, 0);
   out.ok = p.gaussSeidel(K, F, 1000, counters_.block_updates, [&](int j) { return settleCandidate(run, j, F); });
   if (!out.ok) return true;
   u.settle_tau.noalias() += p.U.leftCols(F) * p.f.head(F);

@@ -105,6 +105,16 @@ struct FeatureState {
 /// and writes its own part (a function that needs only one takes it alone).
 struct UnilateralRow : RowGeometry, ImpactState, FrictionState, SettlingState, FeatureState {};
 
+/// A settling candidate's W block, eigen-decomposed (friction_settled.cpp):
+/// its m (= its friction rows) eigenvalues, ascending and clamped at 0, and
+/// their eigenvectors in E's first m columns.
+struct SettleFactor {
+  Vec3 lam = Vec3::Zero();
+  Mat3 E = Mat3::Zero();
+  int m = 0;
+};
+SettleFactor settleFactor(const Mat3& H, int n);
+
 /// What a unilateral constraint's crossing is (the event function located).
 enum class Crossing { None, Gap, Normal, Cone, Slip, Feature };
 
@@ -193,6 +203,8 @@ struct UnilateralState {
   bool settle_off = false;    // this solve slides every contact along its slip
   FrictionProblem settle_problem;
   VecX swmax;                 // per candidate: the largest eigenvalue of its W block
+  std::vector<SettleFactor> settle_factor;  // per candidate: its W block's eigenpairs,
+  std::vector<char> settle_factored;        // once it needs them (friction_settled.cpp)
   VecX vstick;                // an impact's post-impact velocity with every contact sticking
   VecX vsum;                  // an impact's v⁰ + Σ V P over the islands (friction_impact.cpp)
   // Over-constrained sticking contacts (friction_overconstrained.cpp), sized

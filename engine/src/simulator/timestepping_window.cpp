@@ -237,23 +237,34 @@ void Simulator::Impl::watchEvents() {
 
 // The step-size watch: a mark every stall_steps / kStallMarks accepted
 // steps and the simulated time at the last kStallMarks marks; the step size
-// collapsed when the last stall_steps steps advanced less than stall_time.
-// One stretch suffices (the work rule above needs eight): a single hard
-// friction problem is one step, and every example's largest burst at its
-// own tolerance, or the skid-steer's at 1e-12, is 39 steps within 1 ms,
-// cad_car's stall at its steering step 206 (docs/contacts.md §10: why
-// 128). true when it opened a window.
+// collapsed when the last stall_steps steps advanced less than stall_time,
+// or the last half of them less than a hundredth of it (a mean step below
+// 156 ns at the defaults). One stretch suffices (the work rule above needs
+// eight): a single hard friction problem is one step, and every example's
+// largest burst at its own tolerance, or the skid-steer's at 1e-12, is 39
+// steps within 1 ms, and its shortest 64 steps span 6.2 ms; cad_car's stall
+// at its steering step takes 206 steps per ms, 64 of them in 3.2 µs, each
+// costing a hundred times a smooth step, so the second rule opens its
+// window a third of the stall sooner (docs/contacts.md §10: why 128).
+// true when it opened a window.
 bool Simulator::Impl::watchStepSize() {
   const TimeSteppingOptions& o = options_.timestepping;
+  constexpr int kHalf = kStallMarks / 2;
+  constexpr double kHalfTime = 1e-2;  // of stall_time, for half the steps
   if (counters_.steps < step_next_) return false;
   step_next_ = counters_.steps + o.stall_steps / kStallMarks;
   const double oldest = step_t_[step_marks_ % kStallMarks];
+  const double half = step_t_[(step_marks_ + kHalf) % kStallMarks];
   step_t_[step_marks_++ % kStallMarks] = t_;
-  if (step_marks_ < kStallMarks || !(t_ - oldest < o.stall_time)) return false;
+  const bool all_slow = step_marks_ >= kStallMarks && t_ - oldest < o.stall_time;
+  const bool half_slow = step_marks_ >= kHalf && t_ - half < kHalfTime * o.stall_time;
+  if (!all_slow && !half_slow) return false;
   const int contact = last_event_contact_ >= 0 ? last_event_contact_ : namedContact("");
+  const long steps = all_slow ? o.stall_steps : o.stall_steps / 2;
+  const double limit = all_slow ? o.stall_time : kHalfTime * o.stall_time;
   std::ostringstream why;
-  why << "the step size collapsed: the last " << o.stall_steps << " steps advanced "
-      << t_ - oldest << " s of simulated time (less than " << o.stall_time
+  why << "the step size collapsed: the last " << steps << " steps advanced "
+      << t_ - (all_slow ? oldest : half) << " s of simulated time (less than " << limit
       << " s; last mode change: '" << constraints_[contact]->name() << "')";
   if (!timeSteppingStage()) return false;
   openWindow(contact, why.str());

@@ -148,6 +148,8 @@ void Simulator::Impl::sizeUnilateralWorkspace() {
   u.settle_tau = VecX::Zero(model_.nv);
   u.settle_problem.size(model_.nv, island_nf, island_kf, u.res);
   u.swmax = VecX::Zero(island_kf);
+  u.settle_factor.assign(island_kf, {});
+  u.settle_factored.assign(island_kf, 0);
   u.vstick = VecX::Zero(model_.nv);
   u.vsum = VecX::Zero(model_.nv);
   u.over_W = MatX::Zero(island_nf, island_nf);
