@@ -8,7 +8,12 @@
 //     auto and under time-stepping, 10 s;
 //   - a box on four corners pushed to sliding by F = k t (μ 0.5, k 30 N/s,
 //     0.7 s) under time-stepping (h = 1 ms), under events (dopri5, tol
-//     1e-10) and under auto, with the steps each takes.
+//     1e-10) and under auto, with the steps each takes;
+//   - the other scenes of issue 37's done-when under auto, their own
+//     settings: the 12-DoF biped with box soles, servos and joint limits
+//     landing from 2 cm and standing (examples/biped, 5 s), and the servo
+//     differential drive at μ 1 on its step set-point (examples/diff_drive/
+//     diff_drive_servo, 8 s).
 // Each line also gives the work balance's error relative to the energy that
 // moved, and the Gauss–Seidel sweeps per contact problem (time-stepping).
 // Usage: report_contact_schemes [--repeats N | N]   (default 5)
@@ -142,5 +147,9 @@ int main(int argc, char** argv) {
   const char* car = "/examples/cad_car/cad_car.urdf";
   print("cad_car (10 s)", "auto", example(car, 10, ContactScheme::Auto, repeats));
   print("cad_car (10 s)", "timestepping", example(car, 10, ContactScheme::TimeStepping, repeats));
+  print("biped landing (5 s)", "auto",
+        example("/examples/biped/biped.urdf", 5, ContactScheme::Auto, repeats));
+  print("diff_drive_servo (8 s)", "auto",
+        example("/examples/diff_drive/diff_drive_servo.urdf", 8, ContactScheme::Auto, repeats));
   return 0;
 }
