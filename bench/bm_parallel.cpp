@@ -4,14 +4,21 @@
 // state (docs/architecture.md: an immutable Model, all mutable data in Data), so independent scenes step in parallel with no locks.
 // Each benchmark steps 64 rolling disks by 50 RK4 steps each, split over the
 // threads; items/s counts simulation steps. The scaling is the ratio of the
-// two items/s figures measured in the same run.
+// two items/s figures measured in the same run. Five repetitions by default
+// (medians and their coefficient of variation), and the machine's load
+// average before the run (in the report's context) and after it (on
+// stderr): two threads pay only when both cores are free, so a figure
+// without its load says little (bench/results/parallel.md).
 #include "rolling_disk.hpp"
 
 #include <appell/simulator.hpp>
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <fstream>
 #include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -62,4 +69,28 @@ void BM_IndependentSimulations(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_IndependentSimulations)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+// /proc/loadavg's 1, 5 and 15 minute averages.
+std::string loadAverage() {
+  std::ifstream f("/proc/loadavg");
+  std::string one, five, fifteen;
+  f >> one >> five >> fifteen;
+  return one + " " + five + " " + fifteen;
+}
+
+BENCHMARK(BM_IndependentSimulations)
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime()
+    ->Repetitions(5)
+    ->Unit(benchmark::kMillisecond);
+
+int main(int argc, char** argv) {
+  benchmark::AddCustomContext("load_average_before", loadAverage());
+  benchmark::AddCustomContext("hardware_threads", std::to_string(std::thread::hardware_concurrency()));
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  std::fprintf(stderr, "load_average_after: %s\n", loadAverage().c_str());
+  return 0;
+}
