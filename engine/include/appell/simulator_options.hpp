@@ -52,12 +52,14 @@ struct TimeSteppingOptions {
   long stall_work = 100000;
   double stall_time = 1e-3;
   /// … or when the last stall_steps accepted event steps advanced the
-  /// simulated time by less than stall_time (checked every stall_steps/4
-  /// steps): the step size collapsed — a mean step below 7.8 µs at the
-  /// defaults, where every example's largest burst is 39 steps in 1 ms and
-  /// the stalls run at 200 and more (docs/contacts.md §10). Cheap steps that
-  /// stall (a box's four corners at their slip onset) are caught here long
-  /// before their work reaches the rule above.
+  /// simulated time by less than stall_time, or the last stall_steps/2 by
+  /// less than stall_time/100 (checked every stall_steps/4 steps): the step
+  /// size collapsed — a mean step below 7.8 µs, or 156 ns over half as many
+  /// steps, at the defaults, where every example's largest burst is 39 steps
+  /// in 1 ms, its shortest 64 steps span 0.47 ms, and the stalls run at 200
+  /// steps per ms and more (docs/contacts.md §10). Cheap steps that stall (a
+  /// box's four corners at their slip onset) are caught here long before
+  /// their work reaches the rule above.
   long stall_steps = 128;
   // … and when it ends: at least min_window (s, doubled each time the events
   // fail again within a window's length of its end), the contact modes
