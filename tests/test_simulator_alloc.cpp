@@ -93,6 +93,19 @@ struct Arm {
   ~Arm() { g_armed = false; }
 };
 
+/// One step with the counter armed; its allocations added to `allocations`.
+/// (The status is moved out after the counter is disarmed, as the tests
+/// did inline.)
+StepStatus armedStep(Simulator& sim, double h, long& allocations) {
+  StepStatus st;
+  {
+    Arm arm;
+    st = sim.step(h);
+    allocations += g_allocations;
+  }
+  return st;
+}
+
 Model ballWithPendulum() {
   ModelBuilder b;
   b.addBody("ball", -1, SE3::Identity(), JointType::Floating, Vec3::UnitZ(),
@@ -134,12 +147,7 @@ TEST(SimulatorAllocation, StepDoesNotAllocate) {
       ASSERT_TRUE(sim.projectState().ok);
       long allocations = 0;
       for (int k = 0; k < 50; ++k) {
-        StepStatus st;
-        {
-          Arm arm;
-          st = sim.step(1e-3);
-          allocations += g_allocations;
-        }
+        const StepStatus st = armedStep(sim, 1e-3, allocations);
         ASSERT_TRUE(st.ok) << st.message;
       }
       EXPECT_EQ(allocations, 0) << "solver " << which << ", " << toString(it);
@@ -184,12 +192,7 @@ TEST(SimulatorAllocation, CarWithContactRowsDoesNotAllocate) {
     sim.setState(0, q, v);
     long allocations = 0;
     for (int k = 0; k < 30; ++k) {
-      StepStatus st;
-      {
-        Arm arm;
-        st = sim.step(1e-2);
-        allocations += g_allocations;
-      }
+      const StepStatus st = armedStep(sim, 1e-2, allocations);
       ASSERT_TRUE(st.ok) << st.message;
     }
     EXPECT_EQ(allocations, 0) << "solver " << which;
@@ -287,12 +290,7 @@ TEST(SimulatorAllocation, ContactEventsDoNotAllocate) {
       ASSERT_TRUE(sim.setState(0, q, v));
       long allocations = 0, events = 0, slips = 0;
       while (sim.time() < 1.5) {
-        StepStatus st;
-        {
-          Arm arm;
-          st = sim.step(2e-3);
-          allocations += g_allocations;
-        }
+        const StepStatus st = armedStep(sim, 2e-3, allocations);
         ASSERT_TRUE(st.ok) << st.message;
         events += st.events;
         for (const ContactEvent& e : sim.events()) slips += e.kind == ContactEventKind::Slip;
@@ -334,12 +332,7 @@ TEST(SimulatorAllocation, FrictionEventsDoNotAllocate) {
       // 0.1 s past the slip: the slip's first instants slide on the settled
       // direction (friction_settled.cpp), whose solves allocate nothing either.
       while (sim.time() < t_end) {
-        StepStatus st;
-        {
-          Arm arm;
-          st = sim.step(2e-3);
-          allocations += g_allocations;
-        }
+        const StepStatus st = armedStep(sim, 2e-3, allocations);
         ASSERT_TRUE(st.ok) << st.message;
         for (const auto& e : sim.events()) {
           slips += e.kind == ContactEventKind::Slip;
@@ -373,12 +366,7 @@ TEST(SimulatorAllocation, TimeSteppingStepsDoNotAllocate) {
     long allocations = 0, sliding_steps = 0, sticking_steps = 0;
     const double t_end = kPushStart + 3.5 * mu * kBallMass * 9.81 / kPushRate + 0.1;
     while (sim.time() < t_end) {
-      StepStatus st;
-      {
-        Arm arm;
-        st = sim.step(1e-3);
-        allocations += g_allocations;
-      }
+      const StepStatus st = armedStep(sim, 1e-3, allocations);
       ASSERT_TRUE(st.ok) << st.message;
       // (Closed but for the odd step: a spinning body's explicit step lifts
       // it by O(h² ω² |v|) — micrometres here — and it lands again.)
@@ -404,12 +392,7 @@ TEST(SimulatorAllocation, TimeSteppingWithBilateralRowsDoesNotAllocate) {
   ASSERT_GT(sim->constraintData().m_active, 0) << "the mimic rows are closed";
   long allocations = 0, closed_steps = 0;
   while (sim->time() < 0.3) {
-    StepStatus st;
-    {
-      Arm arm;
-      st = sim->step(1e-3);
-      allocations += g_allocations;
-    }
+    const StepStatus st = armedStep(*sim, 1e-3, allocations);
     ASSERT_TRUE(st.ok) << st.message;
     int closed = 0;
     for (int c = 0; c < static_cast<int>(sim->constraints().size()); ++c) {
@@ -448,12 +431,7 @@ TEST(SimulatorAllocation, TimeSteppingServosDoNotAllocate) {
   const auto sim = makeSimulator(s, o);
   long allocations = 0, closed_steps = 0;
   while (sim->time() < 0.5) {
-    StepStatus st;
-    {
-      Arm arm;
-      st = sim->step(1e-3);
-      allocations += g_allocations;
-    }
+    const StepStatus st = armedStep(*sim, 1e-3, allocations);
     ASSERT_TRUE(st.ok) << st.message;
     closed_steps += sim->isClosed(0);
   }
@@ -486,12 +464,7 @@ TEST(SimulatorAllocation, TerrainFeatureEventsDoNotAllocate) {
       ASSERT_TRUE(sim.setState(0, q, v));
       long allocations = 0, pieces = 0;
       while (sim.time() < 1.0) {
-        StepStatus st;
-        {
-          Arm arm;
-          st = sim.step(2e-3);
-          allocations += g_allocations;
-        }
+        const StepStatus st = armedStep(sim, 2e-3, allocations);
         ASSERT_TRUE(st.ok) << st.message;
         for (const ContactEvent& e : sim.events()) pieces += e.kind == ContactEventKind::Feature;
       }
@@ -528,12 +501,7 @@ TEST(SimulatorAllocation, SecondPointTouchdownsDoNotAllocate) {
       ASSERT_TRUE(sim.setState(0, q, v));
       long allocations = 0, second = 0;
       while (sim.time() < 2.0) {
-        StepStatus st;
-        {
-          Arm arm;
-          st = sim.step(2e-3);
-          allocations += g_allocations;
-        }
+        const StepStatus st = armedStep(sim, 2e-3, allocations);
         ASSERT_TRUE(st.ok) << st.message;
         for (const ContactEvent& e : sim.events())
           second += e.kind == ContactEventKind::Touchdown && e.constraint == 1;
